@@ -1,0 +1,325 @@
+"""Polygonal boundary meshes of one or more closed curves.
+
+A :class:`BoundaryMesh` is a list of straight elements ``I = [a_I, b_I]`` (node indices),
+each with a boundary label (``"D"`` Dirichlet, ``"N"`` Neumann, ``"I"`` interface, ``"C"``
+contact, or any user string) and its own polynomial degree ``p_I >= 1``.
+
+Orientation: an element runs from its first to its second node; the unit normal is the
+tangent turned clockwise, ``n = (t_y, -t_x)``.  Outer boundaries are counter-clockwise and
+holes clockwise, so that ``n`` is the *outward* normal of the domain (the convention of the
+representation formula (1.2)).  :meth:`BoundaryMesh.polygon` orients a single polygon
+counter-clockwise itself.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Iterable, Sequence
+
+import numpy as np
+from numba import njit
+
+LABELS = {"D": "Dirichlet", "N": "Neumann", "I": "interface", "C": "contact"}
+
+
+@njit(cache=True)
+def _first_crossing(nodes, elements):
+    """First pair (k, l) of elements that intersect without sharing a node, or (-1, -1).
+
+    O(ne^2) with a bounding-box early exit; runs once per user-built mesh (refinement
+    cannot create crossings)."""
+    ne = elements.shape[0]
+    for k in range(ne):
+        a0, a1 = nodes[elements[k, 0]], nodes[elements[k, 1]]
+        axmin, axmax = min(a0[0], a1[0]), max(a0[0], a1[0])
+        aymin, aymax = min(a0[1], a1[1]), max(a0[1], a1[1])
+        for l in range(k + 1, ne):
+            if (elements[l, 0] == elements[k, 0] or elements[l, 0] == elements[k, 1]
+                    or elements[l, 1] == elements[k, 0] or elements[l, 1] == elements[k, 1]):
+                continue
+            b0, b1 = nodes[elements[l, 0]], nodes[elements[l, 1]]
+            if (max(b0[0], b1[0]) < axmin or min(b0[0], b1[0]) > axmax
+                    or max(b0[1], b1[1]) < aymin or min(b0[1], b1[1]) > aymax):
+                continue
+            d1 = (a1[0] - a0[0]) * (b0[1] - a0[1]) - (a1[1] - a0[1]) * (b0[0] - a0[0])
+            d2 = (a1[0] - a0[0]) * (b1[1] - a0[1]) - (a1[1] - a0[1]) * (b1[0] - a0[0])
+            d3 = (b1[0] - b0[0]) * (a0[1] - b0[1]) - (b1[1] - b0[1]) * (a0[0] - b0[0])
+            d4 = (b1[0] - b0[0]) * (a1[1] - b0[1]) - (b1[1] - b0[1]) * (a1[0] - b0[0])
+            if d1 * d2 <= 0.0 and d3 * d4 <= 0.0:
+                # collinear disjoint segments give all d = 0: check the projections overlap
+                if d1 == 0.0 and d2 == 0.0:
+                    ax = a1[0] - a0[0]
+                    ay = a1[1] - a0[1]
+                    la = ax * ax + ay * ay
+                    t0 = ((b0[0] - a0[0]) * ax + (b0[1] - a0[1]) * ay) / la
+                    t1 = ((b1[0] - a0[0]) * ax + (b1[1] - a0[1]) * ay) / la
+                    if max(t0, t1) < 0.0 or min(t0, t1) > 1.0:
+                        continue
+                return k, l
+    return -1, -1
+
+
+def _as_per_side(value, nsides: int, name: str):
+    if isinstance(value, (str, int, float, np.integer, np.floating)) or value is None:
+        return [value] * nsides
+    value = list(value)
+    if len(value) != nsides:
+        raise ValueError(f"{name} must be a scalar or one value per side ({nsides}), "
+                         f"got {len(value)} values")
+    return value
+
+
+@dataclass(frozen=True, eq=False)
+class BoundaryMesh:
+    """Straight elements on closed polygonal curves.
+
+    Parameters
+    ----------
+    nodes : (nn, 2) float array
+    elements : (ne, 2) int array of node indices (direction = orientation)
+    labels : (ne,) str array, one label per element
+    degrees : (ne,) int array, polynomial degree p_I >= 1 of each element
+    """
+
+    nodes: np.ndarray
+    elements: np.ndarray
+    labels: np.ndarray
+    degrees: np.ndarray
+    _checked: bool = field(default=False, repr=False)
+
+    def __post_init__(self):
+        nodes = np.ascontiguousarray(self.nodes, dtype=float)
+        elements = np.ascontiguousarray(self.elements, dtype=np.int64)
+        labels = np.asarray(self.labels, dtype=str)
+        degrees = np.ascontiguousarray(self.degrees, dtype=np.int64)
+        for name, arr in (("nodes", nodes), ("elements", elements), ("labels", labels),
+                          ("degrees", degrees)):
+            arr.setflags(write=False)
+            object.__setattr__(self, name, arr)
+        if not self._checked:
+            self._validate()
+
+    # ------------------------------------------------------------------ validation
+    def _validate(self):
+        nodes, elements = self.nodes, self.elements
+        if nodes.ndim != 2 or nodes.shape[1] != 2 or len(nodes) == 0:
+            raise ValueError(f"nodes must have shape (n, 2), got {nodes.shape}")
+        if not np.all(np.isfinite(nodes)):
+            raise ValueError("nodes contain NaN or infinite coordinates")
+        if elements.ndim != 2 or elements.shape[1] != 2 or len(elements) < 3:
+            raise ValueError(f"elements must have shape (ne, 2) with ne >= 3, "
+                             f"got {elements.shape}")
+        if elements.min() < 0 or elements.max() >= len(nodes):
+            raise ValueError("elements refer to node indices outside 0..len(nodes)-1")
+        ne = len(elements)
+        if self.labels.shape != (ne,):
+            raise ValueError(f"labels must have one entry per element ({ne}), "
+                             f"got shape {self.labels.shape}")
+        if self.degrees.shape != (ne,):
+            raise ValueError(f"degrees must have one entry per element ({ne}), "
+                             f"got shape {self.degrees.shape}")
+        if self.degrees.min() < 1:
+            k = int(np.argmin(self.degrees))
+            raise ValueError(f"degree p_I must be >= 1, got p={self.degrees[k]} on element {k}")
+        lengths = np.linalg.norm(nodes[elements[:, 1]] - nodes[elements[:, 0]], axis=1)
+        scale = max(np.ptp(nodes, axis=0).max(), np.finfo(float).tiny)
+        if lengths.min() <= 1e-13 * scale:
+            k = int(np.argmin(lengths))
+            raise ValueError(f"zero-length element: element {k} (nodes {elements[k].tolist()})"
+                             f" has length {lengths[k]:.3g}")
+        used = np.unique(elements)
+        # repeated points: two distinct used nodes at the same place
+        pts = nodes[used]
+        order = np.lexsort((pts[:, 1], pts[:, 0]))
+        gaps = np.linalg.norm(np.diff(pts[order], axis=0), axis=1)
+        if gaps.size and gaps.min() <= 1e-13 * scale:
+            k = int(np.argmin(gaps))
+            a, b = used[order[k]], used[order[k + 1]]
+            raise ValueError(f"repeated point: nodes {a} and {b} coincide at "
+                             f"{nodes[a].tolist()}")
+        # closed curves: every node starts exactly one element and ends exactly one
+        starts = np.bincount(elements[:, 0], minlength=len(nodes))
+        ends = np.bincount(elements[:, 1], minlength=len(nodes))
+        bad = np.flatnonzero((starts != ends) | (starts > 1))
+        if bad.size:
+            k = int(bad[0])
+            raise ValueError(f"curve is not closed: node {k} at {nodes[k].tolist()} starts "
+                             f"{starts[k]} and ends {ends[k]} elements (each node must end "
+                             "one element and start the next)")
+        k, l = _first_crossing(nodes, elements)
+        if k >= 0:
+            raise ValueError(f"self-intersecting boundary: elements {k} and {l} cross")
+
+    # ------------------------------------------------------------------ constructors
+    @classmethod
+    def from_segments(cls, nodes, segments, labels="N", p=1) -> "BoundaryMesh":
+        """Mesh from explicit nodes and segments (any number of closed curves).
+
+        ``labels`` and ``p`` are one value for all or one per segment."""
+        segments = np.asarray(segments)
+        ne = len(segments)
+        labels = np.asarray(_as_per_side(labels, ne, "labels"), dtype=str)
+        degrees = np.asarray(_as_per_side(p, ne, "p"))
+        if np.any(degrees != np.round(degrees)):
+            raise ValueError(f"p must be integer degrees >= 1, got {p!r}")
+        return cls(nodes, segments, labels, degrees.astype(np.int64))
+
+    @classmethod
+    def polygon(cls, vertices, n=None, h=None, labels="N", p=1) -> "BoundaryMesh":
+        """Mesh of one closed polygon.
+
+        Parameters
+        ----------
+        vertices : (m, 2) corners, in order (either orientation; the mesh is made
+            counter-clockwise so that normals point outward)
+        n : int or list of int, number of elements per side
+        h : float or list of float, maximal element size per side (if ``n`` is None)
+        labels : str or list of str, one label per side (side k joins vertex k and k+1)
+        p : int or list of int, polynomial degree per side
+        """
+        v = np.asarray(vertices, dtype=float)
+        if v.ndim != 2 or v.shape[1] != 2 or len(v) < 3:
+            raise ValueError(f"vertices must have shape (m, 2) with m >= 3, got {v.shape}")
+        m = len(v)
+        labels = _as_per_side(labels, m, "labels")
+        ps = _as_per_side(p, m, "p")
+        if n is None and h is None:
+            n = 1
+        if n is not None:
+            ns = _as_per_side(n, m, "n")
+            for k in ns:
+                if int(k) != k or k < 1:
+                    raise ValueError(f"n (elements per side) must be integers >= 1, got {n!r}")
+        else:
+            hs = _as_per_side(h, m, "h")
+            for k in hs:
+                if not (np.isfinite(k) and k > 0):
+                    raise ValueError(f"h (element size) must be positive, got {h!r}")
+        area2 = np.sum(v[:, 0] * np.roll(v[:, 1], -1) - np.roll(v[:, 0], -1) * v[:, 1])
+        side_len = np.linalg.norm(np.roll(v, -1, axis=0) - v, axis=1)
+        if n is None:
+            ns = [max(1, int(np.ceil(L / hk - 1e-9))) for L, hk in zip(side_len, hs)]
+        if area2 < 0:  # clockwise: reverse, side k (v_k -> v_k+1) becomes side m-1-k
+            v = v[::-1]
+            rev = lambda a: list(a)[::-1]  # noqa: E731
+            labels, ps, ns = rev(labels), rev(ps), rev(ns)
+        pts, lab, deg = [], [], []
+        for k in range(m):
+            t = np.arange(int(ns[k]))[:, None] / int(ns[k])
+            pts.append(v[k] + t * (v[(k + 1) % m] - v[k]))
+            lab += [labels[k]] * int(ns[k])
+            deg += [ps[k]] * int(ns[k])
+        nodes = np.vstack(pts)
+        ne = len(nodes)
+        seg = np.column_stack([np.arange(ne), (np.arange(ne) + 1) % ne])
+        return cls.from_segments(nodes, seg, lab, deg)
+
+    @classmethod
+    def join(cls, *meshes: "BoundaryMesh") -> "BoundaryMesh":
+        """Several closed curves in one mesh (e.g. an outer boundary and a hole)."""
+        offs = np.cumsum([0] + [len(m.nodes) for m in meshes])
+        return cls(np.vstack([m.nodes for m in meshes]),
+                   np.vstack([m.elements + o for m, o in zip(meshes, offs)]),
+                   np.concatenate([m.labels for m in meshes]),
+                   np.concatenate([m.degrees for m in meshes]))
+
+    # ------------------------------------------------------------------ geometry
+    @property
+    def n_elements(self) -> int:
+        return len(self.elements)
+
+    @property
+    def a(self) -> np.ndarray:
+        """Start points of the elements, (ne, 2)."""
+        return self.nodes[self.elements[:, 0]]
+
+    @property
+    def b(self) -> np.ndarray:
+        """End points of the elements, (ne, 2)."""
+        return self.nodes[self.elements[:, 1]]
+
+    @property
+    def lengths(self) -> np.ndarray:
+        return np.linalg.norm(self.b - self.a, axis=1)
+
+    @property
+    def tangents(self) -> np.ndarray:
+        return (self.b - self.a) / self.lengths[:, None]
+
+    @property
+    def normals(self) -> np.ndarray:
+        """Unit normals (t_y, -t_x): outward for counter-clockwise outer boundaries."""
+        t = self.tangents
+        return np.column_stack([t[:, 1], -t[:, 0]])
+
+    @property
+    def h_max(self) -> float:
+        return float(self.lengths.max())
+
+    @property
+    def diameter(self) -> float:
+        used = self.nodes[np.unique(self.elements)]
+        return float(np.max(np.linalg.norm(used[:, None, :] - used[None, :, :], axis=2))
+                     if len(used) < 4000 else np.linalg.norm(np.ptp(used, axis=0)))
+
+    def points(self, elem, t) -> np.ndarray:
+        """Physical points of reference coordinates ``t`` in [-1, 1] on elements ``elem``."""
+        elem = np.asarray(elem)
+        t = np.asarray(t, dtype=float)
+        s = 0.5 * (t + 1.0)
+        return self.a[elem] + s[..., None] * (self.b[elem] - self.a[elem])
+
+    def where(self, *labels: str) -> np.ndarray:
+        """Boolean mask of the elements carrying any of ``labels``."""
+        return np.isin(self.labels, labels)
+
+    # ------------------------------------------------------------------ refinement
+    def _replace(self, **kw) -> "BoundaryMesh":
+        args = dict(nodes=self.nodes, elements=self.elements, labels=self.labels,
+                    degrees=self.degrees, _checked=True)
+        args.update(kw)
+        return BoundaryMesh(**args)
+
+    def _marked(self, marked) -> np.ndarray:
+        ne = self.n_elements
+        if marked is None:
+            return np.ones(ne, dtype=bool)
+        marked = np.asarray(marked)
+        if marked.dtype == bool:
+            if marked.shape != (ne,):
+                raise ValueError(f"marked mask must have shape ({ne},), got {marked.shape}")
+            return marked
+        if marked.size and (marked.min() < 0 or marked.max() >= ne):
+            raise ValueError(f"marked element indices must lie in 0..{ne - 1}")
+        mask = np.zeros(ne, dtype=bool)
+        mask[marked.astype(int)] = True
+        return mask
+
+    def refine(self, marked=None) -> "BoundaryMesh":
+        """Bisect the marked elements (all if ``marked`` is None); labels and degrees are
+        inherited, element order along the curves is kept."""
+        mask = self._marked(marked)
+        ne, nn = self.n_elements, len(self.nodes)
+        mid_idx = nn + np.cumsum(mask) - 1
+        new_nodes = np.vstack([self.nodes, 0.5 * (self.a[mask] + self.b[mask])])
+        reps = np.where(mask, 2, 1)
+        parent = np.repeat(np.arange(ne), reps)
+        first = np.ones(len(parent), dtype=bool)
+        first[1:] = parent[1:] != parent[:-1]
+        el = self.elements[parent].copy()
+        split = mask[parent]
+        el[split & first, 1] = mid_idx[parent[split & first]]
+        el[split & ~first, 0] = mid_idx[parent[split & ~first]]
+        return self._replace(nodes=new_nodes, elements=el, labels=self.labels[parent],
+                             degrees=self.degrees[parent])
+
+    def with_degrees(self, p) -> "BoundaryMesh":
+        """The same mesh with degree ``p`` (scalar or per element)."""
+        p = np.broadcast_to(np.asarray(p), (self.n_elements,)).astype(np.int64)
+        if p.min() < 1:
+            raise ValueError(f"degree p must be >= 1, got {p.min()}")
+        return self._replace(degrees=p.copy())
+
+    def raise_degree(self, marked=None, by: int = 1) -> "BoundaryMesh":
+        """Raise the degree of the marked elements by ``by``."""
+        return self.with_degrees(self.degrees + by * self._marked(marked))
