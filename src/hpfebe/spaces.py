@@ -56,7 +56,7 @@ def n_local(kind, p):
     return p if kind == 0 else p + 1
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def eval_basis(kind, p, t, gll_x, gll_b, out):
     """Values of the local basis at the reference point t: Legendre P_0..P_{p-1}
     (kind 0) or the Gauss-Lobatto Lagrange polynomials of degree p (kind 1)."""

@@ -10,15 +10,17 @@ parallel without write conflicts (the test space must be discontinuous: W_hp).
 
 from __future__ import annotations
 
+import math
 import warnings
+from functools import lru_cache
 
 import numpy as np
 from numba import njit, prange
 from numba.core.errors import NumbaExperimentalFeatureWarning
 
 from ..quadrature import rule_tables
-from ..spaces import P_MAX, ContinuousSpace, DiscontinuousSpace, gll_tables, n_local
-from .integration import NMAX, adjacent_block, coincident_block, far_block
+from ..spaces import P_MAX, DiscontinuousSpace, eval_basis, gll_tables, n_local
+from .integration import ETA, NMAX, TOL, adjacent_block, coincident_block, far_block
 
 # kernels are passed to the assemblers as first-class numba functions
 warnings.filterwarnings("ignore", category=NumbaExperimentalFeatureWarning)
@@ -26,9 +28,9 @@ warnings.filterwarnings("ignore", category=NumbaExperimentalFeatureWarning)
 
 @njit(cache=True)
 def _pair_block(kernel, logc, haslog, kp, d, nodes, elements, normals, i, j,
-                kt, pt, kr, pr, gx, gw, lx, lw, gll_x, gll_b,
-                phi, psi, kv, Phi, Psi, Kq, tmp, wx, ww, blk):
+                kt, pt, kr, pr, gx, gw, lx, lw, gll_x, gll_b, scratch, blk):
     """Local block of test element i and trial element j into ``blk`` (zeroed here)."""
+    phi, psi, Phi, Psi, Kq, tmp, rxs, rys, wx, ww, stack = scratch
     mt = n_local(kt, pt) * d
     mr = n_local(kr, pr) * d
     for a in range(mt):
@@ -38,7 +40,7 @@ def _pair_block(kernel, logc, haslog, kp, d, nodes, elements, normals, i, j,
     aJ, bJ = nodes[elements[j, 0]], nodes[elements[j, 1]]
     if i == j:
         coincident_block(kernel, logc, haslog, kp, d, aI, bI, normals[i], kt, pt, kr, pr,
-                         gx, gw, lx, lw, gll_x, gll_b, phi, psi, kv, blk)
+                         gx, gw, lx, lw, gll_x, gll_b, phi, psi, Kq, rxs, rys, blk)
         return
     vI, vJ = -1, -1
     for q in range(2):
@@ -48,42 +50,108 @@ def _pair_block(kernel, logc, haslog, kp, d, nodes, elements, normals, i, j,
     if vI >= 0:
         adjacent_block(kernel, logc, haslog, kp, d, aI, bI, normals[i], aJ, bJ, normals[j],
                        vI, vJ, kt, pt, kr, pr, gx, gw, lx, lw, gll_x, gll_b,
-                       phi, psi, kv, Phi, Psi, Kq, tmp, wx, ww, blk)
+                       phi, psi, Phi, Psi, Kq, tmp, rxs, rys, wx, ww, stack, blk)
     else:
         far_block(kernel, logc, haslog, kp, d, aI, bI, normals[i], aJ, bJ, normals[j],
                   0.0, 1.0, 0.0, 1.0, kt, pt, kr, pr, gx, gw, gll_x, gll_b,
-                  Phi, Psi, Kq, tmp, blk)
+                  Phi, Psi, Kq, tmp, rxs, rys, stack, blk)
+
+
+@njit(cache=True)
+def _scratch(nmax, pmax, d):
+    """Work arrays of one thread: basis values, kernel batch, rules, subdivision stack."""
+    return (np.empty(pmax), np.empty(pmax), np.empty((nmax, pmax)), np.empty((nmax, pmax)),
+            np.empty((nmax * nmax, d * d)), np.empty((nmax, pmax, d * d)),
+            np.empty(nmax * nmax), np.empty(nmax * nmax), np.empty(64 * nmax),
+            np.empty(64 * nmax), np.empty((128, 4)))
 
 
 @njit(cache=True, parallel=True)
 def _assemble(kernel, logc, haslog, kp, d, nodes, elements, normals,
               kt, degt, dofs_t, kr, degr, dofs_r, symmetric,
-              gx, gw, lx, lw, gll_x, gll_b, out):
+              gx, gw, lx, lw, gll_x, gll_b, tab_t, tab_r, thr, out):
     ne = elements.shape[0]
     nmax = gx.shape[0] - 1
+    ntab = tab_t.shape[1] - 1
     pmax = max(degt.max(), degr.max()) + 1
+    dd = d * d
+    L = np.empty(ne)
+    mid = np.empty((ne, 2))
+    for e in range(ne):
+        a, b = nodes[elements[e, 0]], nodes[elements[e, 1]]
+        L[e] = math.hypot(b[0] - a[0], b[1] - a[1])
+        mid[e, 0] = 0.5 * (a[0] + b[0])
+        mid[e, 1] = 0.5 * (a[1] + b[1])
     for idx in prange(ne):
         # interleave short and long rows of the triangle (symmetric case) for balance
         i = idx // 2 if idx % 2 == 0 else ne - 1 - idx // 2
-        phi = np.empty(pmax)
-        psi = np.empty(pmax)
-        kv = np.empty(d * d)
-        Phi = np.empty((nmax, pmax))
-        Psi = np.empty((nmax, pmax))
-        Kq = np.empty((nmax, nmax, d * d))
-        tmp = np.empty((nmax, pmax, d * d))
-        wx = np.empty(4 * nmax * 16)
-        ww = np.empty(4 * nmax * 16)
+        scratch = _scratch(nmax, pmax, d)
+        Kq = scratch[4]
+        rxs, rys = scratch[6], scratch[7]
         blk = np.empty((pmax * d, pmax * d))
         j0 = i if symmetric else 0
         pt = degt[i]
         mt = n_local(kt, pt)
+        aI, bI = nodes[elements[i, 0]], nodes[elements[i, 1]]
         for j in range(j0, ne):
             pr = degr[j]
             mr = n_local(kr, pr)
-            _pair_block(kernel, logc, haslog, kp, d, nodes, elements, normals, i, j,
-                        kt, pt, kr, pr, gx, gw, lx, lw, gll_x, gll_b,
-                        phi, psi, kv, Phi, Psi, Kq, tmp, wx, ww, blk)
+            # fast path for well separated pairs (most of them): the lower bound
+            # |mid_i - mid_j| - (L_i + L_j)/2 of the distance fixes the Gauss orders via
+            # the thresholds thr[deg, n] of integration._order, basis values are tabulated
+            dlow = (math.hypot(mid[i, 0] - mid[j, 0], mid[i, 1] - mid[j, 1])
+                    - 0.5 * (L[i] + L[j]))
+            nx = ntab
+            ny = ntab
+            if dlow >= 2.0 * ETA * max(L[i], L[j]):
+                rx_ = 2.0 * dlow / L[i]
+                ry_ = 2.0 * dlow / L[j]
+                dt_ = pt - 1 if kt == 0 else pt
+                dr_ = pr - 1 if kr == 0 else pr
+                nx = 1
+                while nx < ntab and rx_ < thr[dt_, nx]:
+                    nx += 1
+                ny = 1
+                while ny < ntab and ry_ < thr[dr_, ny]:
+                    ny += 1
+            if nx < ntab and ny < ntab:
+                aJ, bJ = nodes[elements[j, 0]], nodes[elements[j, 1]]
+                for a in range(nx):
+                    x0 = aI[0] + gx[nx, a] * (bI[0] - aI[0])
+                    x1 = aI[1] + gx[nx, a] * (bI[1] - aI[1])
+                    for b in range(ny):
+                        rxs[a * ny + b] = x0 - (aJ[0] + gx[ny, b] * (bJ[0] - aJ[0]))
+                        rys[a * ny + b] = x1 - (aJ[1] + gx[ny, b] * (bJ[1] - aJ[1]))
+                kernel(rxs, rys, nx * ny, normals[i], normals[j], kp, Kq)
+                for q in range(nx * ny):
+                    w = gw[nx, q // ny] * gw[ny, q % ny] * L[i] * L[j]
+                    if haslog:
+                        lr = 0.5 * math.log(rxs[q] * rxs[q] + rys[q] * rys[q])
+                        for c in range(dd):
+                            Kq[q, c] = w * (Kq[q, c] + logc[c] * lr)
+                    else:
+                        for c in range(dd):
+                            Kq[q, c] *= w
+                # blk[k, l] = sum_a phi_k(a) sum_b Kq[a, b] psi_l(b), in two stages
+                tmp = scratch[5]
+                for a in range(nx):
+                    for l in range(mr):
+                        for c in range(dd):
+                            acc = 0.0
+                            for b in range(ny):
+                                acc += Kq[a * ny + b, c] * tab_r[pr, ny, b, l]
+                            tmp[a, l, c] = acc
+                for k in range(mt):
+                    for l in range(mr):
+                        for c1 in range(d):
+                            for c2 in range(d):
+                                acc = 0.0
+                                for a in range(nx):
+                                    acc += tab_t[pt, nx, a, k] * tmp[a, l, c1 * d + c2]
+                                blk[k * d + c1, l * d + c2] = acc
+            else:
+                _pair_block(kernel, logc, haslog, kp, d, nodes, elements, normals, i, j,
+                            kt, pt, kr, pr, gx, gw, lx, lw, gll_x, gll_b, scratch, blk)
             for k in range(mt):
                 gk = dofs_t[i, k]
                 if gk < 0:
@@ -98,6 +166,37 @@ def _assemble(kernel, logc, haslog, kp, d, nodes, elements, normals,
                             out[gk * d + c1, gl * d + c2] += v
                             if symmetric and j != i:
                                 out[gl * d + c2, gk * d + c1] += v
+
+
+NTAB = 12  # far pairs needing fewer Gauss points than this use tabulated basis values
+
+
+@lru_cache(maxsize=None)
+def _far_tables(kind: int, pmax: int):
+    """Basis values tab[p, n, a, k] at the n-point Gauss nodes (on [0,1]) for degrees
+    p <= pmax, and order thresholds thr[deg, n]: the smallest distance/half-length ratio
+    for which n points meet integration.TOL (the inverse of integration._order)."""
+    gx, _, _, _ = rule_tables(NMAX)
+    gll_x, gll_b = gll_tables(P_MAX)
+    tab = np.zeros((pmax + 1, NTAB + 1, NTAB, pmax + 1))
+    for p in range(1, pmax + 1):
+        for n in range(1, NTAB + 1):
+            for a in range(n):
+                eval_basis(kind, p, 2.0 * gx[n, a] - 1.0, gll_x, gll_b, tab[p, n, a])
+    tab.setflags(write=False)
+    return tab
+
+
+@lru_cache(maxsize=None)
+def _order_thresholds(degmax: int):
+    thr = np.full((degmax + 1, NTAB + 1), np.inf)
+    for deg in range(degmax + 1):
+        for n in range(1, NTAB + 1):
+            if 2 * n > deg:
+                rho = math.exp(math.log(1.0 / TOL) / (2 * n - deg))
+                thr[deg, n] = 0.5 * (rho - 1.0 / rho)
+    thr.setflags(write=False)
+    return thr
 
 
 def _space_arrays(space):
@@ -129,9 +228,11 @@ def assemble(kernel, logc, kp, test, trial, d: int = 1, symmetric: bool = False)
     kt, degt, dofs_t = _space_arrays(test)
     kr, degr, dofs_r = _space_arrays(trial)
     out = np.zeros((test.ndof * d, trial.ndof * d))
+    pmax = int(mesh.degrees.max())
     _assemble(kernel, logc, bool(np.any(logc != 0.0)), kp, d, mesh.nodes, mesh.elements,
               np.ascontiguousarray(mesh.normals), kt, degt, dofs_t, kr, degr, dofs_r,
-              symmetric, gx, gw, lx, lw, gll_x, gll_b, out)
+              symmetric, gx, gw, lx, lw, gll_x, gll_b, _far_tables(kt, pmax),
+              _far_tables(kr, pmax), _order_thresholds(pmax), out)
     if not np.all(np.isfinite(out)):
         raise FloatingPointError("assembly produced non-finite entries "
                                  "(degenerate geometry or degree too high?)")
@@ -151,11 +252,8 @@ def local_block(kernel, logc, kp, mesh, i: int, j: int, test_kind: int, trial_ki
     pmax = max(pt, pr) + 1
     blk = np.zeros((pmax * d, pmax * d))
     _pair_block(kernel, logc, bool(np.any(logc != 0.0)), kp, d, mesh.nodes, mesh.elements,
-                   np.ascontiguousarray(mesh.normals), i, j, test_kind, pt, trial_kind, pr,
-                   gx, gw, lx, lw, gll_x, gll_b, np.empty(pmax), np.empty(pmax),
-                   np.empty(d * d), np.empty((nmax, pmax)), np.empty((nmax, pmax)),
-                   np.empty((nmax, nmax, d * d)), np.empty((nmax, pmax, d * d)),
-                   np.empty(64 * nmax), np.empty(64 * nmax), blk)
+                np.ascontiguousarray(mesh.normals), i, j, test_kind, pt, trial_kind, pr,
+                gx, gw, lx, lw, gll_x, gll_b, _scratch(nmax, pmax, d), blk)
     mt = (pt if test_kind == 0 else pt + 1) * d
     mr = (pr if trial_kind == 0 else pr + 1) * d
     return blk[:mt, :mr].copy()

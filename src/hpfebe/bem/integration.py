@@ -23,8 +23,11 @@ function each (the split of HILBERT and the ETH 2D parametric BEM code):
   grows with log(size / distance) through the Bernstein-ellipse radius rho:
   n = ln(1/tol) / (2 ln rho) + (degree + 1)/2.
 
-Kernels are numba functions ``kernel(rx, ry, nx0, nx1, ny0, ny1, kp, out)`` writing the
-d*d values of k_reg(r) (r = x - y, normals n_x, n_y, parameters kp) into ``out``;
+Kernels are numba functions ``kernel(rx, ry, npts, n_x, n_y, kp, out)`` writing the d*d
+values of k_reg(r) at the points r = (rx[q], ry[q]) = x - y, q < npts, into the rows
+``out[q, :]`` (row-major d x d; normals n_x, n_y of the two elements, parameters kp).
+They are called once per batch of quadrature points (one indirect call per tensor
+rule, so the loop inside the kernel is compiled and vectorised on its own).
 ``logc`` is the (d*d) array of the log coefficients A.
 """
 
@@ -46,8 +49,10 @@ ETA = 1.0            # admissibility: dist >= ETA * size
 def _order(ratio, deg, nmax):
     """Gauss order for a function analytic outside a singularity at distance ``ratio``
     (relative to the half length of the interval) times a polynomial of degree deg."""
+    # Gauss error for (poly of degree deg) x (analytic in the Bernstein ellipse rho):
+    # ~ rho^(deg - 2n), so n = (ln(1/TOL) / ln(rho) + deg) / 2
     rho = ratio + math.sqrt(ratio * ratio + 1.0)
-    n = int(math.ceil(math.log(1.0 / TOL) / (2.0 * math.log(rho)))) + (deg + 2) // 2
+    n = int(math.ceil(0.5 * (math.log(1.0 / TOL) / math.log(rho) + deg)))
     return min(max(n, 1), nmax)
 
 
@@ -77,7 +82,8 @@ def _seg_dist(ax, ay, bx, by, cx, cy, dx, dy):
 
 @njit(cache=True)
 def _tensor_rect(kernel, logc, haslog, kp, d, aI, bI, nI, aJ, bJ, nJ, s0, s1, g0, g1,
-                 kt, pt, kr, pr, nx, ny, gx, gw, gll_x, gll_b, Phi, Psi, Kq, tmp, out):
+                 kt, pt, kr, pr, nx, ny, gx, gw, gll_x, gll_b, Phi, Psi, Kq, tmp, rxs, rys,
+                 out):
     """Tensor Gauss (nx x ny) on [s0,s1] x [g0,g1] of the element parameters; adds the
     block to ``out`` (shape (mt*d, mr*d), row = k*d + c1, col = l*d + c2)."""
     LI = math.hypot(bI[0] - aI[0], bI[1] - aI[1])
@@ -103,20 +109,22 @@ def _tensor_rect(kernel, logc, haslog, kp, d, aI, bI, nI, aJ, bJ, nJ, s0, s1, g0
         x1 = aI[1] + s * (bI[1] - aI[1])
         for b in range(ny):
             g = g0 + (g1 - g0) * gx[ny, b]
-            rx = x0 - (aJ[0] + g * (bJ[0] - aJ[0]))
-            ry = x1 - (aJ[1] + g * (bJ[1] - aJ[1]))
-            kernel(rx, ry, nI[0], nI[1], nJ[0], nJ[1], kp, Kq[a, b])
-            if haslog:
-                lr = 0.5 * math.log(rx * rx + ry * ry)
-                for c in range(dd):
-                    Kq[a, b, c] += logc[c] * lr
+            rxs[a * ny + b] = x0 - (aJ[0] + g * (bJ[0] - aJ[0]))
+            rys[a * ny + b] = x1 - (aJ[1] + g * (bJ[1] - aJ[1]))
+    npts = nx * ny
+    kernel(rxs, rys, npts, nI, nJ, kp, Kq)
+    if haslog:
+        for q in range(npts):
+            lr = 0.5 * math.log(rxs[q] * rxs[q] + rys[q] * rys[q])
+            for c in range(dd):
+                Kq[q, c] += logc[c] * lr
     # out[k, l] += sum_a Phi[a,k] sum_b Kq[a,b] Psi[b,l]
     for a in range(nx):
         for l in range(mr):
             for c in range(dd):
                 acc = 0.0
                 for b in range(ny):
-                    acc += Kq[a, b, c] * Psi[b, l]
+                    acc += Kq[a * ny + b, c] * Psi[b, l]
                 tmp[a, l, c] = acc
     for k in range(mt):
         for l in range(mr):
@@ -130,17 +138,30 @@ def _tensor_rect(kernel, logc, haslog, kp, d, aI, bI, nI, aJ, bJ, nJ, s0, s1, g0
 
 @njit(cache=True)
 def far_block(kernel, logc, haslog, kp, d, aI, bI, nI, aJ, bJ, nJ, s0, s1, g0, g1,
-              kt, pt, kr, pr, gx, gw, gll_x, gll_b, Phi, Psi, Kq, tmp, out):
+              kt, pt, kr, pr, gx, gw, gll_x, gll_b, Phi, Psi, Kq, tmp, rxs, rys, stack,
+              out):
     """Disjoint (sub)elements: bisect the parameter rectangle until every piece is
-    admissible, then tensor Gauss with orders from the distance/size ratio."""
+    admissible, then tensor Gauss with orders from the distance/size ratio.
+    ``stack`` is scratch space of shape (>= 128, 4)."""
     nmax = gx.shape[0] - 1
-    stack = np.empty((128, 4))
-    stack[0, 0], stack[0, 1], stack[0, 2], stack[0, 3] = s0, s1, g0, g1
-    top = 1
     LI = math.hypot(bI[0] - aI[0], bI[1] - aI[1])
     LJ = math.hypot(bJ[0] - aJ[0], bJ[1] - aJ[1])
     degt = pt - 1 if kt == 0 else pt
     degr = pr - 1 if kr == 0 else pr
+    if s0 == 0.0 and s1 == 1.0 and g0 == 0.0 and g1 == 1.0:
+        # well separated pair (the common case): midpoint distance minus the half
+        # lengths is a lower bound of the distance, enough to choose the orders
+        dlow = (math.hypot(0.5 * (aI[0] + bI[0] - aJ[0] - bJ[0]),
+                           0.5 * (aI[1] + bI[1] - aJ[1] - bJ[1])) - 0.5 * (LI + LJ))
+        if dlow >= 2.0 * ETA * max(LI, LJ):
+            nx = _order(2.0 * dlow / LI, degt, nmax)
+            ny = _order(2.0 * dlow / LJ, degr, nmax)
+            _tensor_rect(kernel, logc, haslog, kp, d, aI, bI, nI, aJ, bJ, nJ, 0.0, 1.0,
+                         0.0, 1.0, kt, pt, kr, pr, nx, ny, gx, gw, gll_x, gll_b,
+                         Phi, Psi, Kq, tmp, rxs, rys, out)
+            return
+    stack[0, 0], stack[0, 1], stack[0, 2], stack[0, 3] = s0, s1, g0, g1
+    top = 1
     while top > 0:
         top -= 1
         u0, u1, v0, v1 = stack[top, 0], stack[top, 1], stack[top, 2], stack[top, 3]
@@ -154,7 +175,8 @@ def far_block(kernel, logc, haslog, kp, d, aI, bI, nI, aJ, bJ, nJ, s0, s1, g0, g
             nx = _order(2.0 * dist / hx, degt, nmax)
             ny = _order(2.0 * dist / hy, degr, nmax)
             _tensor_rect(kernel, logc, haslog, kp, d, aI, bI, nI, aJ, bJ, nJ, u0, u1, v0, v1,
-                         kt, pt, kr, pr, nx, ny, gx, gw, gll_x, gll_b, Phi, Psi, Kq, tmp, out)
+                         kt, pt, kr, pr, nx, ny, gx, gw, gll_x, gll_b, Phi, Psi, Kq, tmp,
+                         rxs, rys, out)
             continue
         split_x = hx > 0.5 * hy
         split_y = hy > 0.5 * hx
@@ -181,7 +203,7 @@ def far_block(kernel, logc, haslog, kp, d, aI, bI, nI, aJ, bJ, nJ, s0, s1, g0, g
 
 @njit(cache=True)
 def coincident_block(kernel, logc, haslog, kp, d, aI, bI, nI, kt, pt, kr, pr,
-                     gx, gw, lx, lw, gll_x, gll_b, phi, psi, kv, out):
+                     gx, gw, lx, lw, gll_x, gll_b, phi, psi, Kq, rxs, rys, out):
     """I = J (straight): Sauter-Schwab in z = |s - sigma| with the exact log rule."""
     L = math.hypot(bI[0] - aI[0], bI[1] - aI[1])
     ex = (bI[0] - aI[0]) / L
@@ -217,20 +239,21 @@ def coincident_block(kernel, logc, haslog, kp, d, aI, bI, nI, kt, pt, kr, pr,
                     eval_basis(kt, pt, 2.0 * s - 1.0, gll_x, gll_b, phi)
                     eval_basis(kr, pr, 2.0 * g - 1.0, gll_x, gll_b, psi)
                     if part == 0:
-                        kernel(sgn * z * L * ex, sgn * z * L * ey, nI[0], nI[1], nI[0], nI[1],
-                               kp, kv)
+                        rxs[0] = sgn * z * L * ex
+                        rys[0] = sgn * z * L * ey
+                        kernel(rxs, rys, 1, nI, nI, kp, Kq)
                         if haslog:
                             for c in range(dd):
-                                kv[c] += logc[c] * logL
+                                Kq[0, c] += logc[c] * logL
                     else:
                         for c in range(dd):
-                            kv[c] = logc[c]
+                            Kq[0, c] = logc[c]
                     for k in range(mt):
                         for l in range(mr):
                             f = w * phi[k] * psi[l]
                             for c1 in range(d):
                                 for c2 in range(d):
-                                    out[k * d + c1, l * d + c2] += f * kv[c1 * d + c2]
+                                    out[k * d + c1, l * d + c2] += f * Kq[0, c1 * d + c2]
             if part == 1 and not haslog:
                 break
 
@@ -257,7 +280,7 @@ def _graded_rule(zr, zi, deg, gx, gw, xs, ws):
             zeta = complex((2.0 * zr - a - b) / h, 2.0 * zi / h)
             root = np.sqrt(zeta * zeta - 1.0)
             rho = max(abs(zeta + root), abs(zeta - root))
-            n = int(math.ceil(math.log(1.0 / TOL) / (2.0 * math.log(rho)))) + (deg + 2) // 2
+            n = int(math.ceil(0.5 * (math.log(1.0 / TOL) / math.log(rho) + deg)))
             n = min(max(n, 1), nmax)
             if npts + n > xs.shape[0]:
                 n = xs.shape[0] - npts
@@ -276,7 +299,7 @@ def _graded_rule(zr, zi, deg, gx, gw, xs, ws):
 @njit(cache=True)
 def adjacent_block(kernel, logc, haslog, kp, d, aI, bI, nI, aJ, bJ, nJ, vI, vJ,
                    kt, pt, kr, pr, gx, gw, lx, lw, gll_x, gll_b,
-                   phi, psi, kv, Phi, Psi, Kq, tmp, wx, ww, out):
+                   phi, psi, Phi, Psi, Kq, tmp, rxs, rys, wx, ww, stack, out):
     """I and J share a vertex: vI = 0 if it is I's start, 1 if its end; likewise vJ."""
     LI = math.hypot(bI[0] - aI[0], bI[1] - aI[1])
     LJ = math.hypot(bJ[0] - aJ[0], bJ[1] - aJ[1])
@@ -325,9 +348,9 @@ def adjacent_block(kernel, logc, haslog, kp, d, aI, bI, nI, aJ, bJ, nJ, vI, vJ,
                     eval_basis(kt, pt, 2.0 * s - 1.0, gll_x, gll_b, phi)
                     eval_basis(kr, pr, 2.0 * g - 1.0, gll_x, gll_b, psi)
                     if part == 0:
-                        rx = ell * (a_loc * dIx - b_loc * dJx)
-                        ry = ell * (a_loc * dIy - b_loc * dJy)
-                        kernel(rx, ry, nI[0], nI[1], nJ[0], nJ[1], kp, kv)
+                        rxs[0] = ell * (a_loc * dIx - b_loc * dJx)
+                        rys[0] = ell * (a_loc * dIy - b_loc * dJy)
+                        kernel(rxs, rys, 1, nI, nJ, kp, Kq)
                         if haslog:
                             if tri == 0:
                                 R = math.hypot(dIx - w * dJx, dIy - w * dJy)
@@ -335,22 +358,24 @@ def adjacent_block(kernel, logc, haslog, kp, d, aI, bI, nI, aJ, bJ, nJ, vI, vJ,
                                 R = math.hypot(w * dIx - dJx, w * dIy - dJy)
                             lr = math.log(ell * R)
                             for c in range(dd):
-                                kv[c] += logc[c] * lr
+                                Kq[0, c] += logc[c] * lr
                     else:
                         for c in range(dd):
-                            kv[c] = logc[c]
+                            Kq[0, c] = logc[c]
                     for k in range(mt):
                         for l in range(mr):
                             f = wt * phi[k] * psi[l]
                             for c1 in range(d):
                                 for c2 in range(d):
-                                    out[k * d + c1, l * d + c2] += f * kv[c1 * d + c2]
+                                    out[k * d + c1, l * d + c2] += f * Kq[0, c1 * d + c2]
     # the part of the longer element outside the Duffy square is a far pair
     if LI > LJ * (1.0 + 1e-13):
         s0, s1 = (fI, 1.0) if vI == 0 else (0.0, 1.0 - fI)
         far_block(kernel, logc, haslog, kp, d, aI, bI, nI, aJ, bJ, nJ, s0, s1, 0.0, 1.0,
-                  kt, pt, kr, pr, gx, gw, gll_x, gll_b, Phi, Psi, Kq, tmp, out)
+                  kt, pt, kr, pr, gx, gw, gll_x, gll_b, Phi, Psi, Kq, tmp, rxs, rys, stack,
+                  out)
     elif LJ > LI * (1.0 + 1e-13):
         g0, g1 = (fJ, 1.0) if vJ == 0 else (0.0, 1.0 - fJ)
         far_block(kernel, logc, haslog, kp, d, aI, bI, nI, aJ, bJ, nJ, 0.0, 1.0, g0, g1,
-                  kt, pt, kr, pr, gx, gw, gll_x, gll_b, Phi, Psi, Kq, tmp, out)
+                  kt, pt, kr, pr, gx, gw, gll_x, gll_b, Phi, Psi, Kq, tmp, rxs, rys, stack,
+                  out)

@@ -54,16 +54,18 @@ from .integration import NMAX, _order
 INV_2PI = 1.0 / (2.0 * math.pi)
 
 
-@njit(cache=True, inline="always")
-def single_layer_kernel(rx, ry, nx0, nx1, ny0, ny1, kp, out):
+@njit(cache=True)
+def single_layer_kernel(rx, ry, npts, nx, ny, kp, out):
     """Regular part of G: log R / (2 pi); the log part -1/(2 pi) log|r| is ``logc``."""
-    out[0] = kp[0]
+    for q in range(npts):
+        out[q, 0] = kp[0]
 
 
-@njit(cache=True, inline="always")
-def double_layer_kernel(rx, ry, nx0, nx1, ny0, ny1, kp, out):
+@njit(cache=True)
+def double_layer_kernel(rx, ry, npts, nx, ny, kp, out):
     """d_{n_y} G(x, y) = (x - y) . n_y / (2 pi |x - y|^2), r = x - y."""
-    out[0] = INV_2PI * (rx * ny0 + ry * ny1) / (rx * rx + ry * ry)
+    for q in range(npts):
+        out[q, 0] = INV_2PI * (rx[q] * ny[0] + ry[q] * ny[1]) / (rx[q] * rx[q] + ry[q] * ry[q])
 
 
 SINGLE_LAYER_LOGC = np.array([-INV_2PI])
@@ -139,7 +141,8 @@ class LaplaceBEM:
         """Hypersingular operator, V_hp x V_hp: <W U, U'> = <V dU/ds, dU'/ds>."""
         def build():
             T = self.T
-            W = (T.T @ (T.T @ self.V.T).T)
+            VT = np.ascontiguousarray((T.T @ self.V).T)  # V T, using V = V^T
+            W = T.T @ VT
             return 0.5 * (W + W.T)
         return self._get("W", build)
 

@@ -1,0 +1,8 @@
+"""``python -m hpfebe``: the same as the ``hpfebe`` console script."""
+
+import sys
+
+from .cli import main
+
+if __name__ == "__main__":
+    sys.exit(main())

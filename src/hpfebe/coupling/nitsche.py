@@ -1,0 +1,256 @@
+"""hp-Nitsche FE/BE coupling for the Poisson interface problem (Section 2.2).
+
+Find U = (U1, U2) in V_hp = V1_hp x V2_hp with a_h(U, Phi) = l(Phi) for all Phi, (2.3),
+
+    a_h(U, Phi) = (grad U1, grad Phi1)_Omega1 + <S_hat U2, Phi2>_Sigma2
+                  - <dn U1, [Phi]>_GI - <[U], dn Phi1>_GI
+                  + <lambda_Nit h1^-1 p1^alpha [U], [Phi]>_GI,                    (2.4)
+    l(Phi)      = (f, Phi1)_Omega1 + <t_hat, Phi>_GN,
+
+[U] = U1 - U2 on Gamma_I, dn = grad . n1 with n1 the outer normal of Omega1 (the one-sided
+flux {dn Phi} := dn Phi1 of [31]); h1, p1: size and degree of the FE element K at x.
+
+Algebraic form (Section 2.2.4), dofs not on Gamma_D only:
+
+    [ A1 - F11 - F11^T + lam P11     F21^T - lam P12 ] [U1]   [f1]
+    [ F21 - lam P12^T                S_hat + lam P22 ] [U2] = [f2]
+
+    F11 = N^T W Dn,  F21 = B^T W Dn,  P11 = N^T W_s N,  P12 = N^T W_s B,  P22 = B^T W_s B,
+
+with N, Dn, B the FE values, FE normal derivatives and BE values at the Gauss points of the
+common refinement (:mod:`.interface`), W the weights and W_s = W h1^-1 p1^alpha.  Everything
+except the factor lam = lambda_Nit is assembled once (``NitscheFEBE.__init__``), so a
+lambda_Nit sweep only rescales the penalty blocks (``blocks(lam)``).
+
+alpha and h1: the thesis does not state the alpha of its experiments, and defines h_K as
+the diameter of K.  The defaults DEFAULT_ALPHA = 0 and h1 = the length of K's edge on
+Gamma_I (``h_def="edge"``; for the square elements of the examples the side, diam K / sqrt 2)
+are the choices that reproduce the thesis's FE errors: with them Table 2.2 (p = 1, 2, 3,
+h^-1 = 2) and Table 2.4 (h^-1 = 4, 8, 16) come out equal to all printed digits, while
+alpha = 2 or h_def="diameter" change the p = 2, 3 errors by 10-60 % (experiments/ch2_*.py
+record the comparison).  alpha = 2, the choice that makes the bound of Lemma 2.2.3
+p-independent, is available as a parameter.
+
+Solver (``solve``): the FE block is large and sparse, S_hat is small and dense.  We
+factorise the FE block K11 once per lambda with a sparse LU and condense onto the BE dofs
+(static condensation / Schur complement)
+
+    (K22 - K21 K11^-1 K12) U2 = f2 - K21 K11^-1 f1,     K11 U1 = f1 - K12 U2,
+
+where K11^-1 K12 is needed only for the columns of the BE dofs on Gamma_I (K12 is zero
+elsewhere), formed in chunks so that no dense n1 x n2 array is kept.  The FE block is never
+densified; the dense part is the n2 x n2 BE Schur complement, solved by LU.  The residual of
+the full system is computed and returned; a singular or ill-conditioned solve raises.
+"""
+
+from __future__ import annotations
+
+import logging
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+import scipy.linalg as sla
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+
+from ..bem import LaplaceBEM
+from ..fem.poisson import PoissonFE
+from ..quadrature import gauss_legendre
+from ..spaces import lagrange_values
+from .examples import InterfaceProblem
+from .interface import interface_rule
+
+log = logging.getLogger(__name__)
+
+DEFAULT_ALPHA = 0.0
+DEFAULT_LAMBDA = 10.0
+DEFAULT_H_DEF = "edge"
+
+
+@dataclass
+class NitscheSolution:
+    """Solution of (2.3): U1 (FE, all dofs of ``fe``), U2 (BE, all dofs of ``V_space``),
+    and solver diagnostics (``info``: residual, timings, sizes)."""
+
+    lam: float
+    U1: np.ndarray
+    U2: np.ndarray
+    info: dict = field(default_factory=dict)
+
+
+def be_values(be_mesh, V_space, elem, t) -> sp.csr_matrix:
+    """Sparse (npts x ndof) values of the V_hp basis at reference points ``t`` of the
+    boundary elements ``elem`` (grouped by degree, vectorised)."""
+    n = len(elem)
+    rows, cols, vals = [], [], []
+    for p in np.unique(be_mesh.degrees[elem]):
+        sel = np.flatnonzero(be_mesh.degrees[elem] == p)
+        phi = lagrange_values(int(p), t[sel])                      # (k, p+1)
+        dofs = V_space.elem_dofs[elem[sel], :int(p) + 1]
+        keep = dofs >= 0
+        rows.append(np.broadcast_to(sel[:, None], dofs.shape)[keep])
+        cols.append(dofs[keep])
+        vals.append(phi[keep])
+    return sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
+                         shape=(n, V_space.ndof))
+
+
+class NitscheFEBE:
+    """The coupled system (2.3)-(2.4) of one pair of meshes and degrees.
+
+    Parameters
+    ----------
+    problem : InterfaceProblem (geometry, exact solution, data)
+    fe_h_inv, be_h_inv : inverse mesh sizes of the FE mesh of Omega1 and the BE mesh of
+        dOmega2 (non-matching on Gamma_I in general)
+    p_fe, p_be : polynomial degrees p1 (FE) and p2 (BE; default p1)
+    alpha : exponent of p1 in the penalty term (2.4)
+    h_def : "diameter" (h_K = diam K, Section 2.1) or "edge" (edge length on Gamma_I)
+    """
+
+    def __init__(self, problem: InterfaceProblem, fe_h_inv: float, be_h_inv: float,
+                 p_fe: int, p_be: int | None = None, alpha: float = DEFAULT_ALPHA,
+                 h_def: str = DEFAULT_H_DEF):
+        if not isinstance(problem, InterfaceProblem):
+            raise ValueError(f"problem must be an InterfaceProblem, got {problem!r}")
+        if not np.isfinite(alpha):
+            raise ValueError(f"alpha must be a finite number, got {alpha!r}")
+        p_be = p_fe if p_be is None else p_be
+        if int(p_be) != p_be or p_be < 1:
+            raise ValueError(f"p_be must be an integer >= 1, got {p_be!r}")
+        self.problem, self.alpha, self.h_def = problem, float(alpha), h_def
+        self.p_fe, self.p_be = int(p_fe), int(p_be)
+        self.fe_h_inv, self.be_h_inv = float(fe_h_inv), float(be_h_inv)
+        t = {}
+        t0 = time.perf_counter()
+        self.domain = problem.fe_domain(fe_h_inv)
+        self.fe = PoissonFE(self.domain, self.p_fe)
+        A = self.fe.A
+        t["fe_stiffness"] = time.perf_counter() - t0
+
+        t0 = time.perf_counter()
+        self.be_mesh = problem.be_mesh(be_h_inv, self.p_be)
+        self.bem = LaplaceBEM(self.be_mesh)
+        V = self.bem.V_space
+        S_hat = self.bem.S_hat
+        t["be_S_hat"] = time.perf_counter() - t0
+
+        t0 = time.perf_counter()
+        fixed2 = V.dofs_on("D")
+        mask = np.ones(V.ndof, dtype=bool)
+        mask[fixed2] = False
+        self.free1, self.free2 = self.fe.free, np.flatnonzero(mask)
+        # Gauss points per piece: exact for the mass (p1 + p2) and flux (2 p1) terms
+        order = max(self.p_fe, self.p_be) + 1
+        self.rule = rule = interface_rule(self.domain, self.be_mesh, order, h_def)
+        N, Gx, Gy = self.fe.eval_matrices(rule.x, rule.fe_cell)
+        Dn = sp.diags(rule.n1[:, 0]) @ Gx + sp.diags(rule.n1[:, 1]) @ Gy
+        Bv = be_values(self.be_mesh, V, rule.be_elem, rule.t_be)
+        sigma = self.fe.p ** self.alpha / rule.h1           # h1^-1 p1^alpha
+        W, Ws = sp.diags(rule.w), sp.diags(rule.w * sigma)
+        f1, f2 = self.free1, self.free2
+        NT, BT = N.T.tocsr(), Bv.T.tocsr()
+        self.A1 = A[f1][:, f1].tocsr()
+        self.S = np.ascontiguousarray(S_hat[np.ix_(f2, f2)])
+        self.F11 = (NT @ W @ Dn).tocsr()[f1][:, f1]
+        self.F21 = (BT @ W @ Dn).tocsr()[f2][:, f1]
+        self.P11 = (NT @ Ws @ N).tocsr()[f1][:, f1]
+        self.P12 = (NT @ Ws @ Bv).tocsr()[f1][:, f2]
+        self.P22 = (BT @ Ws @ Bv).toarray()[np.ix_(f2, f2)]
+        t["coupling"] = time.perf_counter() - t0
+
+        t0 = time.perf_counter()
+        self.b1 = (self.fe.load(problem.f)
+                   + self.fe.neumann_load(problem.grad_u, ("N",)))[f1]
+        self.b2 = self._be_neumann_load()[f2]
+        t["rhs"] = time.perf_counter() - t0
+        self.timings = t
+        self.n1, self.n2 = len(f1), len(f2)
+        log.debug("Nitsche %s: FE h^-1=%g p=%d (%d dofs), BE h^-1=%g p=%d (%d dofs), "
+                  "%d interface pieces", problem.name, fe_h_inv, self.p_fe, self.n1,
+                  be_h_inv, self.p_be, self.n2, rule.n_pieces)
+
+    @property
+    def ndof(self) -> int:
+        """Number of unknowns (FE + BE, Dirichlet dofs excluded)."""
+        return self.n1 + self.n2
+
+    def _be_neumann_load(self) -> np.ndarray:
+        """<t_hat, Phi2> on BE elements labelled "N" (t_hat = grad u . n2, n2 outward
+        for Omega2).  Zero for the thesis's examples (no BE Neumann part)."""
+        mesh, V = self.be_mesh, self.bem.V_space
+        out = np.zeros(V.ndof)
+        els = np.flatnonzero(mesh.where("N"))
+        if els.size == 0:
+            return out
+        xq, wq = gauss_legendre(self.p_be + 6)
+        e = np.repeat(els, len(xq))
+        t = np.tile(xq, len(els))
+        x = mesh.points(e, t)
+        gx, gy = self.problem.grad_u(x[:, 0], x[:, 1])
+        n = mesh.normals[e]
+        g = (gx * n[:, 0] + gy * n[:, 1]) * np.tile(wq, len(els)) * mesh.lengths[e] / 2
+        return be_values(mesh, V, e, t).T @ g
+
+    # ----------------------------------------------------------------- the system
+    def blocks(self, lam: float):
+        """K11 (sparse), K12 (sparse), K22 (dense) of the system for lambda_Nit = lam."""
+        lam = self._check_lambda(lam)
+        K11 = (self.A1 - self.F11 - self.F11.T + lam * self.P11).tocsc()
+        K12 = (self.F21.T - lam * self.P12).tocsc()
+        K22 = self.S + lam * self.P22
+        return K11, K12, K22
+
+    def matrix(self, lam: float) -> sp.csr_matrix:
+        """The whole system matrix (sparse, BE block stored densely) - for checks."""
+        K11, K12, K22 = self.blocks(lam)
+        return sp.bmat([[K11, K12], [K12.T, sp.csr_matrix(K22)]]).tocsr()
+
+    @staticmethod
+    def _check_lambda(lam) -> float:
+        lam = float(lam)
+        if not (np.isfinite(lam) and lam >= 0):
+            raise ValueError(f"lambda_Nit must be a finite number >= 0, got {lam!r}")
+        return lam
+
+    def solve(self, lam: float = DEFAULT_LAMBDA, chunk: int = 256) -> NitscheSolution:
+        """Solve (2.3) by static condensation onto the BE dofs (module doc)."""
+        t0 = time.perf_counter()
+        K11, K12, K22 = self.blocks(lam)
+        try:
+            lu = spla.splu(K11)
+        except RuntimeError as exc:
+            raise np.linalg.LinAlgError(f"FE block singular for lambda_Nit={lam}: {exc}") \
+                from exc
+        K21 = K12.T.tocsr()
+        cols = np.flatnonzero(np.diff(K12.indptr))   # BE dofs coupled to the FE part
+        schur = K22.copy()
+        for s in range(0, len(cols), chunk):
+            c = cols[s:s + chunk]
+            X = lu.solve(K12[:, c].toarray())
+            schur[:, c] -= K21 @ X
+        g1 = lu.solve(self.b1)
+        rhs2 = self.b2 - K21 @ g1
+        try:
+            lu2 = sla.lu_factor(schur, check_finite=True)
+        except (ValueError, sla.LinAlgError) as exc:
+            raise np.linalg.LinAlgError(f"BE Schur complement singular: {exc}") from exc
+        U2 = sla.lu_solve(lu2, rhs2)
+        U1 = lu.solve(self.b1 - K12 @ U2)
+        r1 = K11 @ U1 + K12 @ U2 - self.b1
+        r2 = K21 @ U1 + K22 @ U2 - self.b2
+        bnorm = np.sqrt(self.b1 @ self.b1 + self.b2 @ self.b2)
+        res = float(np.sqrt(r1 @ r1 + r2 @ r2) / max(bnorm, np.finfo(float).tiny))
+        if not (np.all(np.isfinite(U1)) and np.all(np.isfinite(U2))):
+            raise FloatingPointError(f"solution not finite for lambda_Nit={lam}")
+        if res > 1e-6:
+            raise np.linalg.LinAlgError(f"coupled solve inaccurate for lambda_Nit={lam}: "
+                                        f"relative residual {res:.2e}")
+        full1 = np.zeros(self.fe.ndof)
+        full1[self.free1] = U1
+        full2 = np.zeros(self.bem.V_space.ndof)
+        full2[self.free2] = U2
+        info = {"residual": res, "solve_s": time.perf_counter() - t0, "n_fe": self.n1,
+                "n_be": self.n2, "n_schur_cols": int(len(cols)), **self.timings}
+        return NitscheSolution(float(lam), full1, full2, info)

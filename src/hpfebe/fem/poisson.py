@@ -1,0 +1,157 @@
+"""Q_p finite elements for the Poisson part of the FE/BE coupling (Chapter 2, Omega1).
+
+Space: V1_hp of Section 2.1 on a rectangle mesh (:mod:`hpfebe.fem.meshes`), the tensor
+product element Q_p of scikit-fem (``ElementQuadP``: vertex functions, integrated-Legendre
+edge and interior functions; ``ElementQuad1`` for p = 1, the same space).  It is
+H1-conforming on meshes whose cells share one orientation, which
+:func:`~hpfebe.fem.meshes.tensor_block_mesh` guarantees (a test checks the traces from both
+sides of every interior edge).  Dirichlet data are zero on Gamma_D (the thesis's examples);
+Dirichlet dofs are removed by selection (``free``), the matrices keep all dofs.
+"""
+
+from __future__ import annotations
+
+import logging
+from functools import cached_property
+
+import numpy as np
+import scipy.sparse as sp
+from skfem import Basis, BilinearForm, ElementQuad1, ElementQuadP, FacetBasis, Functional
+from skfem import LinearForm, asm
+from skfem.helpers import dot, grad
+
+from .meshes import FEDomain
+
+P_MAX_FE = 10
+
+
+@BilinearForm
+def laplace(u, v, w):
+    """(grad u, grad v): the FE part of a_h in (2.4)."""
+    return dot(grad(u), grad(v))
+
+
+def quad_element(p: int):
+    """The Q_p element (H1-conforming on consistently oriented rectangle meshes)."""
+    if int(p) != p or not 1 <= p <= P_MAX_FE:
+        raise ValueError(f"p (FE degree) must be an integer in 1..{P_MAX_FE}, got {p!r}")
+    if p == 1:
+        return ElementQuad1()
+    log = logging.getLogger("skfem")
+    level = log.level
+    log.setLevel(logging.ERROR)  # silence the "use ElementQuad2 for speed" advice
+    try:
+        return ElementQuadP(int(p))
+    finally:
+        log.setLevel(level)
+
+
+class PoissonFE:
+    """Q_p finite elements on an :class:`FEDomain` with u = 0 on the facets ``dirichlet``.
+
+    Attributes: ``basis`` (skfem CellBasis), ``ndof``, ``free`` (dofs not on Gamma_D),
+    ``A`` (stiffness, all dofs, assembled once).
+    """
+
+    def __init__(self, domain: FEDomain, p: int, dirichlet: tuple[str, ...] = ("D",)):
+        if not isinstance(domain, FEDomain):
+            raise ValueError(f"domain must be an FEDomain, got {type(domain).__name__}")
+        self.domain = domain
+        self.p = int(p)
+        self.element = quad_element(p)
+        # Q_p x Q_p products on rectangles are polynomials of degree 2p per direction
+        self.basis = Basis(domain.mesh, self.element, intorder=2 * self.p + 1)
+        self.ndof = self.basis.N
+        fixed = [domain.facets[lab] for lab in dirichlet if lab in domain.facets]
+        fixed = np.concatenate(fixed) if fixed else np.zeros(0, dtype=np.int64)
+        self.fixed = (np.unique(self.basis.get_dofs(facets=fixed).all()) if fixed.size
+                      else np.zeros(0, dtype=np.int64))
+        mask = np.ones(self.ndof, dtype=bool)
+        mask[self.fixed] = False
+        self.free = np.flatnonzero(mask)
+
+    @cached_property
+    def A(self) -> sp.csr_matrix:
+        """Stiffness matrix (grad U, grad V)_Omega1, all dofs."""
+        return asm(laplace, self.basis).tocsr()
+
+    # ----------------------------------------------------------------- right-hand side
+    def load(self, f) -> np.ndarray:
+        """(f, Phi1)_Omega1 for f(x, y) (vectorised); f = None gives zeros."""
+        if f is None:
+            return np.zeros(self.ndof)
+
+        @LinearForm
+        def lf(v, w):
+            return f(w.x[0], w.x[1]) * v
+        return asm(lf, self.basis)
+
+    def neumann_load(self, grad_u, labels: tuple[str, ...] = ("N",)) -> np.ndarray:
+        """<t_hat, Phi1>_{Gamma_N} with t_hat = grad u . n (outward normal of Omega1)."""
+        facets = [self.domain.facets[lab] for lab in labels if lab in self.domain.facets]
+        if not facets:
+            return np.zeros(self.ndof)
+        fb = FacetBasis(self.domain.mesh, self.element, facets=np.concatenate(facets),
+                        intorder=2 * self.p + 4)
+
+        @LinearForm
+        def lf(v, w):
+            gx, gy = grad_u(w.x[0], w.x[1])
+            return (gx * w.n[0] + gy * w.n[1]) * v
+        return asm(lf, fb)
+
+    # ----------------------------------------------------------------- point evaluation
+    def eval_matrices(self, points: np.ndarray, cells: np.ndarray):
+        """Sparse (npts x ndof) matrices of the basis values and of the x- and
+        y-derivatives at physical ``points`` (npts, 2) lying in (the closure of) the
+        given ``cells``.  Reference coordinates by the inverse element map."""
+        pts = np.asarray(points, dtype=float)
+        cells = np.asarray(cells, dtype=np.int64)
+        if pts.ndim != 2 or pts.shape[1] != 2 or cells.shape != (pts.shape[0],):
+            raise ValueError(f"points must be (n, 2) with one cell each, got {pts.shape}, "
+                             f"{cells.shape}")
+        mapping = self.basis.mapping
+        X = mapping.invF(pts.T[:, :, None], tind=cells)          # (2, npts, 1)
+        if np.abs(X - np.clip(X, 0.0, 1.0)).max(initial=0.0) > 1e-8:
+            raise ValueError("a point lies outside its cell")
+        X = np.clip(X, 0.0, 1.0)
+        nb = self.basis.Nbfun
+        val = np.empty((nb, pts.shape[0]))
+        gx = np.empty_like(val)
+        gy = np.empty_like(val)
+        for k in range(nb):
+            f = self.element.gbasis(mapping, X, k, tind=cells)[0]
+            val[k] = f.value[:, 0]
+            gx[k] = f.grad[0][:, 0]
+            gy[k] = f.grad[1][:, 0]
+        rows = np.tile(np.arange(pts.shape[0]), nb)
+        cols = self.basis.element_dofs[:, cells].ravel()
+        shape = (pts.shape[0], self.ndof)
+        mk = lambda v: sp.csr_matrix((v.ravel(), (rows, cols)), shape=shape)  # noqa: E731
+        return mk(val), mk(gx), mk(gy)
+
+    # ----------------------------------------------------------------- errors
+    def errors(self, U: np.ndarray, u, grad_u, intorder: int | None = None) -> dict:
+        """L2 and H1-seminorm ('energy') errors of the FE solution against the exact
+        solution u(x, y) with gradient grad_u(x, y) -> (ux, uy), on Omega1."""
+        U = np.asarray(U, dtype=float)
+        if U.shape != (self.ndof,):
+            raise ValueError(f"U must have {self.ndof} entries, got {U.shape}")
+        basis = Basis(self.domain.mesh, self.element,
+                      intorder=intorder or 2 * self.p + 6)
+
+        @Functional
+        def e_l2(w):
+            return (w["uh"] - u(w.x[0], w.x[1])) ** 2
+
+        @Functional
+        def e_h1(w):
+            gx, gy = grad_u(w.x[0], w.x[1])
+            return (w["uh"].grad[0] - gx) ** 2 + (w["uh"].grad[1] - gy) ** 2
+
+        uh = basis.interpolate(U)
+        l2 = float(np.sqrt(e_l2.assemble(basis, uh=uh)))
+        h1 = float(np.sqrt(e_h1.assemble(basis, uh=uh)))
+        if not (np.isfinite(l2) and np.isfinite(h1)):
+            raise FloatingPointError("FE error is not finite (solution contains NaN/inf)")
+        return {"l2": l2, "h1": h1}

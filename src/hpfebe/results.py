@@ -1,0 +1,352 @@
+"""What an experiment hands back, and how it is written to ``results/``.
+
+An experiment module returns a list of :class:`ArtefactResult` (one per thesis table or
+figure it produces); :func:`write_result` turns each into
+
+    <out>/<name>.csv    the table (published columns first, then dof, wall_time_s, ...)
+    <out>/<name>.json   claims, notes, meta, keys, tolerances, published file, provenance
+    <out>/<name>.png    the figure, if there is one
+
+Every file is written atomically (temporary file in the same directory, fsync,
+``os.replace``): an interrupted run never leaves a half-written file under the final
+name.  The JSON file is written last, so a result is complete when its JSON exists.
+
+This is an edge module: no numerics, only data containers and file writing.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import platform
+import subprocess
+import sys
+import tempfile
+from dataclasses import dataclass, field
+from datetime import datetime, timezone
+from importlib import metadata
+from pathlib import Path
+from typing import Any, Callable, Iterable
+
+import numpy as np
+import pandas as pd
+
+__all__ = [
+    "Claim",
+    "ArtefactResult",
+    "write_result",
+    "read_result",
+    "atomic_write",
+    "provenance",
+    "progress",
+    "TOLERANCE_KINDS",
+]
+
+#: tolerance kinds: ("factor", f) - reproduced/published within [1/f, f];
+#: ("abs", a) - |reproduced - published| <= a
+TOLERANCE_KINDS = ("factor", "abs")
+
+#: packages whose versions are recorded in every result's provenance
+PROVENANCE_PACKAGES = ("numpy", "scipy", "numba", "scikit-fem", "pandas", "matplotlib",
+                       "hpfebe")
+
+
+@dataclass
+class Claim:
+    """A statement of the thesis, checked against what was measured.
+
+    text : the thesis's claim, e.g. "BE energy rate of the h-version ~0.66 (theory 2/3)"
+    holds : True (holds), False (differs), None (not decidable here)
+    evidence : the measured numbers that decide it, and why it differs if it does
+    """
+
+    text: str
+    holds: bool | None
+    evidence: str = ""
+
+
+@dataclass
+class ArtefactResult:
+    """One thesis artefact (table or figure) as reproduced.
+
+    name : artefact id as in EXPERIMENTS.md, e.g. "table_2_1"
+    table : published columns first (same names as report/published/<file>.csv),
+        then dof, wall_time_s, ...
+    figure : matplotlib figure (required for ``figure_*`` artefacts)
+    published : file name in report/published/, e.g. "table_2_1_nitsche_smooth_h_BE.csv"
+    keys : columns joining the reproduced with the published table
+    tolerances : column -> ("factor", 2.0) or ("abs", 0.15)
+    claims : the thesis's statements, checked
+    notes : choices and explanations shown in the report
+    meta : timings (jit_s, run_s), dof, iterations, ...; ``allow_nan_columns`` lists
+        float columns that may contain NaN (e.g. the first rate of a sweep)
+    """
+
+    name: str
+    table: pd.DataFrame
+    figure: Any = None
+    published: str | None = None
+    keys: tuple[str, ...] = ()
+    tolerances: dict[str, tuple[str, float]] = field(default_factory=dict)
+    claims: list[Claim] = field(default_factory=list)
+    notes: str = ""
+    meta: dict = field(default_factory=dict)
+
+
+# --------------------------------------------------------------------------- progress
+def progress(iterable: Iterable, **kw):
+    """tqdm progress bar on stderr, shown only when stderr is a terminal (quiet in
+    Snakemake jobs, CI and log files).  Keyword arguments go to ``tqdm``."""
+    from tqdm.auto import tqdm
+
+    kw.setdefault("disable", not sys.stderr.isatty())
+    kw.setdefault("file", sys.stderr)
+    return tqdm(iterable, **kw)
+
+
+# --------------------------------------------------------------------------- provenance
+def _repo_root() -> Path:
+    """The repository holding this (editable) package: parent of ``src/``."""
+    return Path(__file__).resolve().parents[2]
+
+
+def _git(*args: str, cwd: Path) -> str | None:
+    try:
+        out = subprocess.run(["git", *args], cwd=cwd, capture_output=True, text=True,
+                             timeout=10, check=True)
+    except (OSError, subprocess.SubprocessError):
+        return None
+    return out.stdout.strip() or None
+
+
+def _version(pkg: str) -> str:
+    try:
+        return metadata.version(pkg)
+    except metadata.PackageNotFoundError:
+        return "not installed"
+
+
+def provenance(config: dict | None = None, run_info: dict | None = None) -> dict:
+    """Where a result comes from: git commit (or "unknown"), whether the work tree had
+    uncommitted changes, package and Python versions, the config used, the UTC date,
+    the host's CPU count and the thread-count environment variables."""
+    root = _repo_root()
+    commit = _git("rev-parse", "HEAD", cwd=root)
+    status = _git("status", "--porcelain", "--untracked-files=no", cwd=root) if commit else None
+    try:
+        affinity = len(os.sched_getaffinity(0))
+    except (AttributeError, OSError):
+        affinity = None
+    prov = {
+        "git_commit": commit or "unknown",
+        "git_dirty": (status is not None) if commit else None,
+        "packages": {pkg: _version(pkg) for pkg in PROVENANCE_PACKAGES},
+        "python": platform.python_version(),
+        "platform": platform.platform(),
+        "config": config if config is not None else {},
+        "date_utc": datetime.now(timezone.utc).isoformat(timespec="seconds"),
+        "host_cpu_count": os.cpu_count(),
+        "cpus_available": affinity,
+        "threads_env": {k: os.environ.get(k) for k in (
+            "NUMBA_NUM_THREADS", "OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS",
+            "MKL_NUM_THREADS")},
+    }
+    if run_info:
+        prov["run"] = run_info
+    return prov
+
+
+# --------------------------------------------------------------------------- atomic I/O
+def _umask() -> int:
+    mask = os.umask(0)
+    os.umask(mask)
+    return mask
+
+
+def atomic_write(path: Path | str, writer: Callable[[Any], None], mode: str = "w") -> Path:
+    """Write ``path`` atomically: ``writer(f)`` fills a temporary file in the same
+    directory, which is flushed, fsync'ed and renamed over ``path``.  If ``writer``
+    raises, the temporary file is removed and ``path`` is left as it was."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+    try:
+        os.chmod(tmp, 0o666 & ~_umask())  # mkstemp makes 0600; give the usual mode
+        with os.fdopen(fd, mode, **({} if "b" in mode else {"encoding": "utf-8",
+                                                             "newline": ""})) as f:
+            writer(f)
+            f.flush()
+            os.fsync(f.fileno())
+        os.replace(tmp, path)
+    except BaseException:
+        try:
+            os.unlink(tmp)
+        except FileNotFoundError:
+            pass
+        raise
+    try:  # make the rename itself durable (best effort, not on every platform)
+        dfd = os.open(path.parent, os.O_RDONLY)
+        try:
+            os.fsync(dfd)
+        finally:
+            os.close(dfd)
+    except OSError:
+        pass
+    return path
+
+
+def _jsonable(obj):
+    """Plain JSON types; non-finite floats become the strings "NaN"/"Infinity"/
+    "-Infinity" (explicit, and the file stays valid JSON)."""
+    if isinstance(obj, dict):
+        return {str(k): _jsonable(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple, set)):
+        return [_jsonable(v) for v in obj]
+    if isinstance(obj, np.ndarray):
+        return [_jsonable(v) for v in obj.tolist()]
+    if isinstance(obj, (bool, np.bool_)):
+        return bool(obj)
+    if isinstance(obj, (int, np.integer)):
+        return int(obj)
+    if isinstance(obj, (float, np.floating)):
+        x = float(obj)
+        if math.isnan(x):
+            return "NaN"
+        if math.isinf(x):
+            return "Infinity" if x > 0 else "-Infinity"
+        return x
+    if obj is None or isinstance(obj, str):
+        return obj
+    if isinstance(obj, Path):
+        return str(obj)
+    return str(obj)
+
+
+# --------------------------------------------------------------------------- validation
+def validate(result: ArtefactResult) -> None:
+    """Check a result against the contract; ``ValueError`` names what is wrong."""
+    name = result.name
+    if not isinstance(name, str) or not name or any(c in name for c in "/\\ ."):
+        raise ValueError(f"result name must be a plain artefact id like 'table_2_1', "
+                         f"got {name!r}")
+    if not isinstance(result.table, pd.DataFrame):
+        raise ValueError(f"{name}: table must be a pandas.DataFrame, got "
+                         f"{type(result.table).__name__}")
+    cols = [str(c) for c in result.table.columns]
+    if len(set(cols)) != len(cols):
+        dup = sorted({c for c in cols if cols.count(c) > 1})
+        raise ValueError(f"{name}: duplicate table columns {dup}")
+    for k in result.keys:
+        if k not in cols:
+            raise ValueError(f"{name}: key column {k!r} is not in the table (columns: {cols})")
+    for col, tol in result.tolerances.items():
+        if col not in cols:
+            raise ValueError(f"{name}: tolerance column {col!r} is not in the table "
+                             f"(columns: {cols})")
+        if (not isinstance(tol, (tuple, list)) or len(tol) != 2
+                or tol[0] not in TOLERANCE_KINDS):
+            raise ValueError(f"{name}: tolerance for {col!r} must be ('factor', f) or "
+                             f"('abs', a), got {tol!r}")
+        if not (isinstance(tol[1], (int, float)) and math.isfinite(tol[1]) and tol[1] >= 0
+                and (tol[0] != "factor" or tol[1] >= 1)):
+            raise ValueError(f"{name}: tolerance value for {col!r} must be finite, >= 0 "
+                             f"(>= 1 for 'factor'), got {tol[1]!r}")
+    if result.tolerances and result.published and not result.keys:
+        raise ValueError(f"{name}: tolerances against a published table need join keys")
+    if result.published is not None and (
+            not isinstance(result.published, str) or "/" in result.published):
+        raise ValueError(f"{name}: published must be a file name in report/published/, "
+                         f"got {result.published!r}")
+    for c in result.claims:
+        if not isinstance(c, Claim):
+            raise ValueError(f"{name}: claims must be Claim objects, got {type(c).__name__}")
+        if c.holds not in (True, False, None):
+            raise ValueError(f"{name}: Claim.holds must be True, False or None, got "
+                             f"{c.holds!r} for {c.text!r}")
+    allowed = set(result.meta.get("allow_nan_columns", ()))
+    unknown = allowed - set(cols)
+    if unknown:
+        raise ValueError(f"{name}: allow_nan_columns names columns not in the table: "
+                         f"{sorted(unknown)}")
+    for col in result.table.columns:
+        s = result.table[col]
+        if str(col) in allowed:
+            continue
+        bad = s.isna()  # NaN in float columns, NaN/None/NA in text or nullable ones
+        if bad.any():
+            raise ValueError(
+                f"{name}: column {col!r} has NaN (missing values) in {int(bad.sum())} "
+                f"row(s) (first row "
+                f"{int(np.flatnonzero(bad.to_numpy())[0])}); NaN is allowed only in "
+                "columns listed in meta['allow_nan_columns'] and explained in notes")
+    if name.startswith("figure_") and result.figure is None:
+        raise ValueError(f"{name}: figure artefacts must return a figure")
+
+
+# --------------------------------------------------------------------------- writing
+def write_result(result: ArtefactResult, out_dir: Path | str, config: dict | None = None,
+                 *, run_info: dict | None = None) -> list[Path]:
+    """Write ``<out>/<name>.csv``, ``.png`` (if there is a figure) and ``.json``
+    (last), each atomically.  Returns the paths written.
+
+    Raises ValueError (naming the column) if a float column has NaN that is not in
+    ``result.meta['allow_nan_columns']``, and for any other breach of the contract.
+    ``run_info`` (quick flag, config files, wall time of the run) goes into the
+    provenance."""
+    validate(result)
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    written = []
+
+    table = result.table.copy()
+    table.columns = [str(c) for c in table.columns]
+    written.append(atomic_write(out / f"{result.name}.csv",
+                                lambda f: table.to_csv(f, index=False)))
+
+    png = out / f"{result.name}.png"
+    if result.figure is not None:
+        written.append(atomic_write(png, lambda f: result.figure.savefig(
+            f, format="png", dpi=120, bbox_inches="tight"), mode="wb"))
+    elif png.exists():  # a stale figure from an earlier run would be mistaken as current
+        png.unlink()
+
+    doc = {
+        "name": result.name,
+        "kind": artefact_kind(result.name),
+        "published": result.published,
+        "keys": list(result.keys),
+        "tolerances": {k: [v[0], v[1]] for k, v in result.tolerances.items()},
+        "claims": [{"text": c.text, "holds": c.holds, "evidence": c.evidence}
+                   for c in result.claims],
+        "notes": result.notes,
+        "meta": result.meta,
+        "columns": list(table.columns),
+        "n_rows": int(len(table)),
+        "has_figure": result.figure is not None,
+        "provenance": provenance(config, run_info),
+    }
+    text = json.dumps(_jsonable(doc), indent=2, allow_nan=False) + "\n"
+    written.append(atomic_write(out / f"{result.name}.json", lambda f: f.write(text)))
+    return written
+
+
+def artefact_kind(name: str) -> str:
+    """'table' for table_*, 'figure' for figure_*, else 'other'."""
+    if name.startswith("table_"):
+        return "table"
+    if name.startswith("figure_"):
+        return "figure"
+    return "other"
+
+
+def read_result(results_dir: Path | str, name: str) -> tuple[dict, pd.DataFrame] | None:
+    """The JSON document and the table of a written result, or None if either is
+    missing (not built, or interrupted before the JSON was written)."""
+    d = Path(results_dir)
+    js, csv = d / f"{name}.json", d / f"{name}.csv"
+    if not (js.exists() and csv.exists()):
+        return None
+    with open(js, encoding="utf-8") as f:
+        doc = json.load(f)
+    return doc, pd.read_csv(csv)
