@@ -229,6 +229,19 @@ class BoundaryMesh:
         return len(self.elements)
 
     @property
+    def n_curves(self) -> int:
+        """Number of closed curves (connected components of the element graph)."""
+        from scipy.sparse import coo_matrix
+        from scipy.sparse.csgraph import connected_components
+
+        used = np.unique(self.elements)
+        nn = len(self.nodes)
+        g = coo_matrix((np.ones(self.n_elements), (self.elements[:, 0], self.elements[:, 1])),
+                       shape=(nn, nn))
+        ncomp, lab = connected_components(g, directed=False)
+        return int(len(np.unique(lab[used])))
+
+    @property
     def a(self) -> np.ndarray:
         """Start points of the elements, (ne, 2)."""
         return self.nodes[self.elements[:, 0]]

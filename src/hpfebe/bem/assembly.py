@@ -1,8 +1,8 @@
 """Dense Galerkin assembly of boundary integral operators, parallel over element pairs.
 
-One routine, :func:`assemble`, serves every operator: it is specialised by the numba
-kernel function (Laplace V and K here, Lame in :mod:`hpfebe.bem.lame`) and by the
-test/trial spaces.  Each pair of elements is classified (coincident / adjacent / far),
+One routine, :func:`assemble`, serves every operator: it is specialised by the kernel
+(an id of :mod:`hpfebe.bem.kernels`: Laplace V and K, Lame) and by the test/trial
+spaces.  Each pair of elements is classified (coincident / adjacent / far),
 integrated by the matching function of :mod:`hpfebe.bem.integration` into a local block,
 and scattered.  Rows belong to test elements, so the loop over test elements runs in
 parallel without write conflicts (the test space must be discontinuous: W_hp).
@@ -11,19 +11,15 @@ parallel without write conflicts (the test space must be discontinuous: W_hp).
 from __future__ import annotations
 
 import math
-import warnings
 from functools import lru_cache
 
 import numpy as np
 from numba import njit, prange
-from numba.core.errors import NumbaExperimentalFeatureWarning
 
 from ..quadrature import rule_tables
 from ..spaces import P_MAX, DiscontinuousSpace, eval_basis, gll_tables, n_local
 from .integration import ETA, NMAX, TOL, adjacent_block, coincident_block, far_block
-
-# kernels are passed to the assemblers as first-class numba functions
-warnings.filterwarnings("ignore", category=NumbaExperimentalFeatureWarning)
+from .kernels import kernel_batch
 
 
 @njit(cache=True)
@@ -122,7 +118,7 @@ def _assemble(kernel, logc, haslog, kp, d, nodes, elements, normals,
                     for b in range(ny):
                         rxs[a * ny + b] = x0 - (aJ[0] + gx[ny, b] * (bJ[0] - aJ[0]))
                         rys[a * ny + b] = x1 - (aJ[1] + gx[ny, b] * (bJ[1] - aJ[1]))
-                kernel(rxs, rys, nx * ny, normals[i], normals[j], kp, Kq)
+                kernel_batch(kernel, rxs, rys, nx * ny, normals[i], normals[j], kp, Kq)
                 for q in range(nx * ny):
                     w = gw[nx, q // ny] * gw[ny, q % ny] * L[i] * L[j]
                     if haslog:
@@ -204,8 +200,10 @@ def _space_arrays(space):
     return space.kind, np.ascontiguousarray(space.mesh.degrees), space.elem_dofs
 
 
-def assemble(kernel, logc, kp, test, trial, d: int = 1, symmetric: bool = False) -> np.ndarray:
-    """Dense Galerkin matrix of the kernel ``k(r) = logc * log|r| + kernel(r)`` with rows
+def assemble(kernel: int, logc, kp, test, trial, d: int = 1,
+             symmetric: bool = False) -> np.ndarray:
+    """Dense Galerkin matrix of the kernel ``k(r) = logc * log|r| + k_reg(r)`` (``kernel``
+    the id of k_reg in :mod:`hpfebe.bem.kernels`) with rows
     from ``test`` (a :class:`DiscontinuousSpace`) and columns from ``trial``.
 
     ``d`` is the number of components (1 Laplace, 2 Lame): global index = d*dof + c.

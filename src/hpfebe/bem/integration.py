@@ -23,12 +23,9 @@ function each (the split of HILBERT and the ETH 2D parametric BEM code):
   grows with log(size / distance) through the Bernstein-ellipse radius rho:
   n = ln(1/tol) / (2 ln rho) + (degree + 1)/2.
 
-Kernels are numba functions ``kernel(rx, ry, npts, n_x, n_y, kp, out)`` writing the d*d
-values of k_reg(r) at the points r = (rx[q], ry[q]) = x - y, q < npts, into the rows
-``out[q, :]`` (row-major d x d; normals n_x, n_y of the two elements, parameters kp).
-They are called once per batch of quadrature points (one indirect call per tensor
-rule, so the loop inside the kernel is compiled and vectorised on its own).
-``logc`` is the (d*d) array of the log coefficients A.
+``kernel`` is an integer id of :mod:`hpfebe.bem.kernels`; the regular part k_reg is
+evaluated by ``kernel_batch`` once per batch of quadrature points, ``logc`` is the (d*d)
+array of the log coefficients A.
 """
 
 from __future__ import annotations
@@ -39,6 +36,7 @@ import numpy as np
 from numba import njit
 
 from ..spaces import eval_basis, n_local
+from .kernels import kernel_batch
 
 TOL = 1e-16          # target relative quadrature error per direction
 NMAX = 48            # largest Gauss order in tables
@@ -112,7 +110,7 @@ def _tensor_rect(kernel, logc, haslog, kp, d, aI, bI, nI, aJ, bJ, nJ, s0, s1, g0
             rxs[a * ny + b] = x0 - (aJ[0] + g * (bJ[0] - aJ[0]))
             rys[a * ny + b] = x1 - (aJ[1] + g * (bJ[1] - aJ[1]))
     npts = nx * ny
-    kernel(rxs, rys, npts, nI, nJ, kp, Kq)
+    kernel_batch(kernel, rxs, rys, npts, nI, nJ, kp, Kq)
     if haslog:
         for q in range(npts):
             lr = 0.5 * math.log(rxs[q] * rxs[q] + rys[q] * rys[q])
@@ -241,7 +239,7 @@ def coincident_block(kernel, logc, haslog, kp, d, aI, bI, nI, kt, pt, kr, pr,
                     if part == 0:
                         rxs[0] = sgn * z * L * ex
                         rys[0] = sgn * z * L * ey
-                        kernel(rxs, rys, 1, nI, nI, kp, Kq)
+                        kernel_batch(kernel, rxs, rys, 1, nI, nI, kp, Kq)
                         if haslog:
                             for c in range(dd):
                                 Kq[0, c] += logc[c] * logL
@@ -350,7 +348,7 @@ def adjacent_block(kernel, logc, haslog, kp, d, aI, bI, nI, aJ, bJ, nJ, vI, vJ,
                     if part == 0:
                         rxs[0] = ell * (a_loc * dIx - b_loc * dJx)
                         rys[0] = ell * (a_loc * dIy - b_loc * dJy)
-                        kernel(rxs, rys, 1, nI, nJ, kp, Kq)
+                        kernel_batch(kernel, rxs, rys, 1, nI, nJ, kp, Kq)
                         if haslog:
                             if tri == 0:
                                 R = math.hypot(dIx - w * dJx, dIy - w * dJy)

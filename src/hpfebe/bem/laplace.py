@@ -50,22 +50,8 @@ from ..quadrature import rule_tables
 from ..spaces import P_MAX, ContinuousSpace, DiscontinuousSpace, eval_basis, gll_tables
 from .assembly import assemble
 from .integration import NMAX, _order
+from .kernels import INV_2PI, LAPLACE_DL, LAPLACE_SL
 
-INV_2PI = 1.0 / (2.0 * math.pi)
-
-
-@njit(cache=True)
-def single_layer_kernel(rx, ry, npts, nx, ny, kp, out):
-    """Regular part of G: log R / (2 pi); the log part -1/(2 pi) log|r| is ``logc``."""
-    for q in range(npts):
-        out[q, 0] = kp[0]
-
-
-@njit(cache=True)
-def double_layer_kernel(rx, ry, npts, nx, ny, kp, out):
-    """d_{n_y} G(x, y) = (x - y) . n_y / (2 pi |x - y|^2), r = x - y."""
-    for q in range(npts):
-        out[q, 0] = INV_2PI * (rx[q] * ny[0] + ry[q] * ny[1]) / (rx[q] * rx[q] + ry[q] * ry[q])
 
 
 SINGLE_LAYER_LOGC = np.array([-INV_2PI])
@@ -111,14 +97,14 @@ class LaplaceBEM:
     @property
     def V(self) -> np.ndarray:
         """Single layer, W_hp x W_hp, symmetric positive definite."""
-        return self._get("V", lambda: assemble(single_layer_kernel, SINGLE_LAYER_LOGC,
+        return self._get("V", lambda: assemble(LAPLACE_SL, SINGLE_LAYER_LOGC,
                                                _scale_param(self.scale), self.W_space,
                                                self.W_space, symmetric=True))
 
     @property
     def K(self) -> np.ndarray:
         """Double layer, test W_hp, trial V_hp."""
-        return self._get("K", lambda: assemble(double_layer_kernel, NO_LOG, [0.0],
+        return self._get("K", lambda: assemble(LAPLACE_DL, NO_LOG, [0.0],
                                                self.W_space, self.V_space))
 
     @property
@@ -285,8 +271,8 @@ def local_blocks(mesh: BoundaryMesh, i: int, j: int, scale: float = 1.0) -> dict
     from .assembly import local_block
 
     kp = _scale_param(scale)
-    V = local_block(single_layer_kernel, SINGLE_LAYER_LOGC, kp, mesh, i, j, 0, 0)
-    K = local_block(double_layer_kernel, NO_LOG, [0.0], mesh, i, j, 0, 1)
+    V = local_block(LAPLACE_SL, SINGLE_LAYER_LOGC, kp, mesh, i, j, 0, 0)
+    K = local_block(LAPLACE_DL, NO_LOG, [0.0], mesh, i, j, 0, 1)
     Ts = []
     for e in (i, j):
         p = int(mesh.degrees[e])

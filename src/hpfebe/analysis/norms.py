@@ -1,0 +1,126 @@
+"""Error norms of boundary element solutions against exact data.
+
+Exact data are callables ``f(x, n)`` of points x (m, 2) and outward unit normals n (m, 2)
+(so that a Neumann datum grad u . n can be written directly).
+
+Energy norms use a richer space on the same mesh: the exact function is projected
+(W_hp) or interpolated (V_hp) at degree p_I + ``extra`` - for data that are smooth on
+each element this adds an error of higher order than the one measured - and the discrete
+solution is embedded exactly (the spaces are nested).  Then
+
+* ||psi - psi_h||_V = <V e, e>^(1/2)          (H^-1/2(Gamma)-equivalent, Neumann data),
+* |u - u_h|_W      = <W e, e>^(1/2)          (H^1/2(Gamma) seminorm, Dirichlet data),
+
+with V, W of the richer space (same kernel scale as the operator passed in).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import scipy.linalg as sla
+
+from ..quadrature import gauss_legendre
+from ..spaces import ContinuousSpace, DiscontinuousSpace, legendre_values
+
+
+def _points(mesh, nq: int):
+    """Gauss points of every element: elem (ne*nq,), t, x (.,2), n (.,2), weights ds."""
+    t, w = gauss_legendre(nq)
+    ne = mesh.n_elements
+    elem = np.repeat(np.arange(ne), nq)
+    tt = np.tile(t, ne)
+    x = mesh.points(elem, tt)
+    n = mesh.normals[elem]
+    ds = np.tile(w, ne) * mesh.lengths[elem] / 2.0
+    return elem, tt, x, n, ds
+
+
+def boundary_l2_error(space, coeffs, exact, extra: int = 6) -> float:
+    """||exact - U_h||_{L2(Gamma)} by Gauss quadrature with p_max + ``extra`` points."""
+    nq = int(space.mesh.degrees.max()) + extra
+    elem, t, x, n, ds = _points(space.mesh, nq)
+    diff = np.asarray(exact(x, n), dtype=float) - space.evaluate(coeffs, elem, t)
+    return float(np.sqrt(np.sum(ds * diff**2)))
+
+
+def neumann_functional(space: ContinuousSpace, flux, extra: int = 6) -> np.ndarray:
+    """F_j = int_Gamma flux U_j ds for the basis U_j of V_hp (the load of a Neumann
+    problem; flux(x, n))."""
+    mesh = space.mesh
+    F = np.zeros(space.ndof)
+    for p in np.unique(mesh.degrees):
+        p = int(p)
+        els = np.flatnonzero(mesh.degrees == p)
+        t, w = gauss_legendre(p + extra)
+        x = mesh.points(els[:, None], t[None, :]).reshape(-1, 2)
+        n = np.repeat(mesh.normals[els], len(t), axis=0)
+        fv = np.asarray(flux(x, n), dtype=float).reshape(len(els), len(t))
+        lj = space._values(p, t)                                    # (nq, p+1)
+        loc = (fv * w) @ lj * (mesh.lengths[els, None] / 2.0)       # (ne_p, p+1)
+        d = space.elem_dofs[els, :p + 1]
+        np.add.at(F, d[d >= 0], loc[d >= 0])
+    return F
+
+
+def _richer(op, extra: int):
+    from ..bem.laplace import LaplaceBEM
+
+    return LaplaceBEM(op.mesh.with_degrees(op.mesh.degrees + extra), scale=op.scale)
+
+
+def _project_W(space: DiscontinuousSpace, f, extra: int = 6) -> np.ndarray:
+    """L2 projection of f(x, n) onto W_hp, element by element."""
+    mesh = space.mesh
+    c = np.zeros(space.ndof)
+    for p in np.unique(mesh.degrees):
+        p = int(p)
+        els = np.flatnonzero(mesh.degrees == p)
+        t, w = gauss_legendre(p + extra)
+        x = mesh.points(els[:, None], t[None, :]).reshape(-1, 2)
+        n = np.repeat(mesh.normals[els], len(t), axis=0)
+        fv = np.asarray(f(x, n), dtype=float).reshape(len(els), len(t))
+        k = np.arange(p)
+        c[space.elem_dofs[els, :p]] = (fv * w) @ legendre_values(p, t) * ((2 * k + 1) / 2.0)
+    return c
+
+
+def energy_error_neumann(op, psi_h, flux, extra: int = 4) -> float:
+    """||flux - psi_h||_V for psi_h in op.W_space (Legendre coefficients are nested:
+    the first p_I coefficients of each element carry over to the richer space)."""
+    hi = _richer(op, extra)
+    e = _project_W(hi.W_space, flux)
+    lo_d, hi_d = op.W_space.elem_dofs, hi.W_space.elem_dofs
+    mask = lo_d >= 0
+    e[hi_d[:, :lo_d.shape[1]][mask]] -= np.asarray(psi_h)[lo_d[mask]]
+    return float(np.sqrt(max(e @ hi.V @ e, 0.0)))
+
+
+def energy_error_dirichlet(op, u_h, u, extra: int = 4) -> float:
+    """|u - u_h|_W: u interpolated at degree p_I + extra, u_h embedded by evaluating it
+    at the richer Gauss-Lobatto points (exact: polynomials of lower degree)."""
+    hi = _richer(op, extra)
+    from ..quadrature import gauss_lobatto
+
+    e = np.zeros(hi.V_space.ndof)
+    mesh = hi.mesh
+    for p in np.unique(mesh.degrees):
+        p = int(p)
+        els = np.flatnonzero(mesh.degrees == p)
+        xl, _ = gauss_lobatto(p + 1)
+        elem = np.repeat(els, p + 1)
+        t = np.tile(xl, len(els))
+        x = mesh.points(elem, t)
+        n = mesh.normals[elem]
+        vals = np.asarray(u(x, n), dtype=float) - op.V_space.evaluate(u_h, elem, t)
+        d = hi.V_space.elem_dofs[els, :p + 1].ravel()
+        e[d] = vals
+    return float(np.sqrt(max(e @ hi.W @ e, 0.0)))
+
+
+def dual_energy_norm(op, residual) -> float:
+    """||r||_* = sup_v r.v / ||v||, ||v||^2 = <W v, v> + (int v)^2 (an H^1/2(Gamma)
+    norm on closed curves): the norm in which S_hat U - <flux, .> is measured."""
+    mV = np.asarray(op.M.sum(axis=0)).ravel()  # int U_j ds
+    A = op.W + np.outer(mV, mV)
+    r = np.asarray(residual, dtype=float)
+    return float(np.sqrt(max(r @ sla.solve(A, r, assume_a="pos"), 0.0)))

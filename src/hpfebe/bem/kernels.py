@@ -1,0 +1,116 @@
+"""Kernel functions of the boundary integral operators, and their numba dispatch.
+
+Every kernel k(r) = A log|r| + k_reg(r) (r = x - y) is given by its constant log
+coefficient A (``logc``, d*d values) and a numba function for the regular part,
+
+    kernel(rx, ry, npts, n_x, n_y, kp, out):  out[q, :] = k_reg(rx[q], ry[q])  (q < npts)
+
+(row-major d x d values, normals n_x, n_y of the test and trial elements, parameters kp),
+homogeneous of degree 0 or -1 in r plus constants (what the singular integration of
+:mod:`hpfebe.bem.integration` relies on).  The assemblers are compiled once and receive
+the kernel as an integer id, dispatched by :func:`kernel_batch`: numba's on-disk cache
+cannot hold functions specialised on function-typed arguments across processes, while an
+integer id costs one predictable branch per batch of quadrature points.  A new kernel
+gets an id here and a branch in ``kernel_batch``.
+"""
+
+from __future__ import annotations
+
+import math
+
+from numba import njit
+
+INV_2PI = 1.0 / (2.0 * math.pi)
+
+LAPLACE_SL, LAPLACE_DL, LAME_SL, LAME_DL, LAME_HS = 0, 1, 2, 3, 4
+
+
+@njit(cache=True)
+def laplace_single_layer(rx, ry, npts, nx, ny, kp, out):
+    """G(x,y) = -1/(2 pi) log(|r|/R): regular part log(R)/(2 pi) = kp[0]; the log part
+    -1/(2 pi) log|r| is ``logc``."""
+    for q in range(npts):
+        out[q, 0] = kp[0]
+
+
+@njit(cache=True)
+def laplace_double_layer(rx, ry, npts, nx, ny, kp, out):
+    """d_{n_y} G(x, y) = (x - y) . n_y / (2 pi |x - y|^2)."""
+    for q in range(npts):
+        out[q, 0] = INV_2PI * (rx[q] * ny[0] + ry[q] * ny[1]) / (rx[q] * rx[q] + ry[q] * ry[q])
+
+
+# ------------------------------------------------------------------ 2D Lame (lame.py)
+# kp layout: [c1 log R, c1 c2, lambda, mu, c1, c2, Et log R, Et], Et = E'/(4 pi)
+@njit(cache=True, inline="always")
+def _log_rr(rx, ry, a0, a1, out):
+    """a0 I + a1 r r^T / |r|^2 into out[0:4]."""
+    f = a1 / (rx * rx + ry * ry)
+    out[0] = a0 + f * rx * rx
+    out[1] = f * rx * ry
+    out[2] = out[1]
+    out[3] = a0 + f * ry * ry
+
+
+@njit(cache=True, inline="always")
+def _traction_of_G(rx, ry, ny0, ny1, lam, mu, c1, c2, out):
+    """K_ik(x, y) = [sigma_y(G(x, .) e_i) n_y]_k at r = x - y into out[0:4] (degree -1;
+    on a straight element only its odd Cauchy part survives: principal value)."""
+    r2 = rx * rx + ry * ry
+    for i in range(2):
+        ri = rx if i == 0 else ry
+        e0 = 1.0 if i == 0 else 0.0
+        e1 = 1.0 - e0
+        # D_jl = d v_j / d y_l for v = G(x, .) e_i, with d/dy = -d/dr and
+        # dG_ji/dr_l = c1 (-d_ij r_l + c2 (d_il r_j + d_jl r_i) - 2 c2 r_i r_j r_l/|r|^2)/|r|^2
+        g = 2.0 * c2 * ri / r2
+        d00 = -c1 * (-e0 * rx + c2 * (e0 * rx + ri) - g * rx * rx) / r2
+        d01 = -c1 * (-e0 * ry + c2 * e1 * rx - g * rx * ry) / r2
+        d10 = -c1 * (-e1 * rx + c2 * e0 * ry - g * ry * rx) / r2
+        d11 = -c1 * (-e1 * ry + c2 * (e1 * ry + ri) - g * ry * ry) / r2
+        div = d00 + d11
+        s00 = lam * div + 2.0 * mu * d00
+        s11 = lam * div + 2.0 * mu * d11
+        s01 = mu * (d01 + d10)
+        out[i * 2 + 0] = s00 * ny0 + s01 * ny1
+        out[i * 2 + 1] = s01 * ny0 + s11 * ny1
+
+
+@njit(cache=True)
+def lame_single_layer(rx, ry, npts, nx, ny, kp, out):
+    """Regular part of G: c1 log R I + c1 c2 r r^T / |r|^2 (degree 0); the log part
+    -c1 log|r| I is ``logc``."""
+    for q in range(npts):
+        _log_rr(rx[q], ry[q], kp[0], kp[1], out[q])
+
+
+@njit(cache=True)
+def lame_double_layer(rx, ry, npts, nx, ny, kp, out):
+    """Traction of G with respect to y, (1.4): K_ik = [sigma_y(G e_i) n_y]_k."""
+    for q in range(npts):
+        _traction_of_G(rx[q], ry[q], ny[0], ny[1], kp[2], kp[3], kp[4], kp[5], out[q])
+
+
+@njit(cache=True)
+def lame_hypersingular(rx, ry, npts, nx, ny, kp, out):
+    """Regular part of Vt: E'/(4 pi) (log R I + r r^T/|r|^2); log part -E'/(4 pi) log|r| I."""
+    for q in range(npts):
+        _log_rr(rx[q], ry[q], kp[6], kp[7], out[q])
+
+
+
+@njit(cache=True)
+def kernel_batch(kid, rx, ry, npts, nx, ny, kp, out):
+    """Evaluate the regular part of kernel ``kid`` at a batch of points."""
+    if kid == LAPLACE_SL:
+        laplace_single_layer(rx, ry, npts, nx, ny, kp, out)
+    elif kid == LAPLACE_DL:
+        laplace_double_layer(rx, ry, npts, nx, ny, kp, out)
+    elif kid == LAME_SL:
+        lame_single_layer(rx, ry, npts, nx, ny, kp, out)
+    elif kid == LAME_DL:
+        lame_double_layer(rx, ry, npts, nx, ny, kp, out)
+    elif kid == LAME_HS:
+        lame_hypersingular(rx, ry, npts, nx, ny, kp, out)
+    else:
+        raise ValueError("unknown kernel id")
