@@ -146,6 +146,10 @@ def _check_published(result, published_dir: Path) -> None:
     if missing:
         raise ValueError(f"{result.name}: columns {missing} are not in {result.published} "
                          f"(its columns: {cols})")
+    shared = [c for c in result.table.columns if c in cols]
+    if list(result.table.columns[:len(shared)]) != shared:
+        log.warning("%s: the published columns %s should come first in the table",
+                    result.name, shared)
 
 
 def cmd_run(args) -> int:
@@ -257,7 +261,8 @@ def build_parser() -> argparse.ArgumentParser:
 
     sp = sub.add_parser("run", help="run the experiment module producing ARTEFACT "
                                     "(writes all artefacts of that module)")
-    sp.add_argument("artefact", help="artefact id, e.g. table_2_1 (see `hpfebe list`)")
+    sp.add_argument("artefact", help="artefact id, e.g. table_2_1 (see `hpfebe list`); "
+                                     "a module name works too")
     sp.add_argument("--quick", action="store_true",
                     help="CI-sized run: merge config/quick.yaml over config/config.yaml "
                          "and pass quick=True")

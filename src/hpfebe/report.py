@@ -327,7 +327,7 @@ def _fmt(x, digits=6) -> str:
 def _fmt_diff(cell, tol) -> str:
     if cell["diff"] is None:
         return ""
-    s = f"{cell['diff']:+.3g}"
+    s = "0" if cell["diff"] == 0 else f"{cell['diff']:+.3g}"
     if tol[0] == "factor" and cell["ratio"] is not None and math.isfinite(cell["ratio"]):
         s += f" (x{cell['ratio']:.3g})"
     return s

@@ -1,0 +1,98 @@
+# hpfebe: reproduce every experiment of the thesis and build the report.
+#
+#   snakemake -j2                                  full sweeps (config/config.yaml)
+#   snakemake -j2 --configfile config/quick.yaml   CI-sized sweeps
+#   snakemake -n                                   dry run: what would be (re)built
+#   snakemake --profile profiles/slurm             on a SLURM cluster
+#
+# One rule per experiment module in experiments/ (rule name = module name), generated
+# from the registry; each runs `python -m hpfebe run <first artefact>` and writes all
+# artefacts of its module to results/.  A change of the module file or of a config file
+# reruns it.  `rule report` builds report/index.html and report/report.md.
+
+import shlex
+import sys
+from pathlib import Path
+
+configfile: "config/config.yaml"
+
+sys.path.insert(0, workflow.basedir)
+from experiments.registry import discover  # noqa: E402  (standard library only)
+
+REGISTRY = discover(Path(workflow.basedir) / "experiments")
+RESULTS = "results"
+LOGS = f"{RESULTS}/logs"
+QUICK = bool(config.get("quick", False))
+
+# The config files in the order Snakemake merged them: config/config.yaml, then every
+# --configfile given on the command line.  The CLI merges them the same way.
+CONFIG_FILES = ["config/config.yaml"]
+for _f in workflow.config_settings.configfiles:
+    _f = Path(_f)
+    try:
+        _f = _f.resolve().relative_to(Path.cwd().resolve())
+    except ValueError:
+        pass
+    if str(_f) not in CONFIG_FILES:
+        CONFIG_FILES.append(str(_f))
+
+# One thread per job (snakemake -j2 on 2 cores never oversubscribes): numba, OpenMP and
+# BLAS pools are pinned to the job's thread count.
+THREAD_ENV = " ".join(f"{v}={{threads}}" for v in (
+    "NUMBA_NUM_THREADS", "OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"))
+PYTHON = shlex.quote(sys.executable)
+
+
+def artefact_outputs(artefacts):
+    out = []
+    for a in artefacts:
+        out += [f"{RESULTS}/{a}.csv", f"{RESULTS}/{a}.json"]
+        if a.startswith("figure_"):
+            out.append(f"{RESULTS}/{a}.png")
+    return out
+
+
+ALL_RESULTS = [p for e in REGISTRY for p in artefact_outputs(e.artefacts)]
+
+localrules: all, report
+
+
+rule all:
+    input:
+        "report/index.html",
+        "report/report.md",
+
+
+for _exp in REGISTRY:
+
+    rule:
+        name: _exp.name
+        input:
+            module=str(_exp.path.relative_to(workflow.basedir)),
+            config=CONFIG_FILES,
+        output:
+            artefact_outputs(_exp.artefacts),
+        log:
+            f"{LOGS}/{_exp.name}.log",
+        threads: 1
+        params:
+            artefact=_exp.artefacts[0],
+            flags=" ".join((["--quick"] if QUICK else [])
+                           + [f"--config {shlex.quote(f)}" for f in CONFIG_FILES]),
+        shell:
+            f"{THREAD_ENV} {PYTHON} -m hpfebe run {{params.artefact}} --out {RESULTS} "
+            "{params.flags} 2> {log}"
+
+
+rule report:
+    input:
+        results=ALL_RESULTS,
+        published=sorted(str(p) for p in Path("report/published").glob("*.csv")),
+        builder="src/hpfebe/report.py",
+    output:
+        html="report/index.html",
+        md="report/report.md",
+    log:
+        f"{LOGS}/report.log",
+    shell:
+        f"{PYTHON} -m hpfebe report --results {RESULTS} --out report 2> {{log}}"

@@ -1,0 +1,58 @@
+"""Experiment modules: one per thesis scene, each producing one or more artefacts.
+
+The contract
+============
+
+A module ``experiments/<scene>.py`` reproduces one computation of the thesis and may
+produce several artefacts from it (a sweep shared by table_2_1, table_2_2 and figure_2_2
+is computed once)::
+
+    \"\"\"Which thesis section and equations; every choice made where the thesis is
+    silent (these choices are also repeated in the results' ``notes``).\"\"\"
+
+    from hpfebe.results import ArtefactResult, Claim, progress
+
+    ARTEFACTS = ("table_2_1", "table_2_2", "figure_2_2")   # ids as in EXPERIMENTS.md
+
+    def run(config: dict, quick: bool = False) -> list[ArtefactResult]:
+        ...
+
+Rules
+-----
+* ``ARTEFACTS`` is a literal tuple of strings at module level (it is read without
+  importing the module, see :mod:`experiments.registry`).  An artefact belongs to
+  exactly one module.  ``table_*`` artefacts produce ``results/<id>.csv`` and
+  ``.json``; ``figure_*`` artefacts must also return a figure (``results/<id>.png``).
+* ``config`` is the module's own section of ``config/config.yaml`` (key = module name);
+  with ``--quick`` (Snakemake: ``--configfile config/quick.yaml``) the section of
+  ``config/quick.yaml`` is merged over it (nested dicts merged, other values replaced).
+  A missing section gives ``{}``.  ``quick`` is True in quick mode, for anything the
+  config does not already say.
+* ``run`` returns one :class:`hpfebe.results.ArtefactResult` per entry of
+  ``ARTEFACTS`` (no more, no fewer).  It does not write files: ``hpfebe run`` validates
+  all results first and then writes them (:func:`hpfebe.results.write_result`), so a
+  contract breach never leaves half a set.
+* ``table``: the published columns first, with the same names as in
+  ``report/published/<published>``, then what else was measured (``dof``,
+  ``wall_time_s``, iterations ...).  ``keys`` are the columns joining it with the
+  published table; ``tolerances`` map value columns to ``("factor", f)`` (ratio
+  within [1/f, f]) or ``("abs", a)`` (|difference| <= a).  Only columns listed in
+  ``tolerances`` are compared in the report.
+* NaN in a float column is an error unless the column is listed in
+  ``meta["allow_nan_columns"]`` and explained in ``notes`` (e.g. the first rate of a
+  sweep, a solver that did not converge).
+* ``claims``: the thesis's statements for this artefact, each with
+  ``holds`` = True / False / None (not decidable here) and the measured ``evidence``;
+  if a claim does not hold, the evidence says why.
+* ``meta``: timings (``jit_s``, ``run_s``), dof, iterations, ...  ``run_s`` is shown
+  as the artefact's wall time in the report.
+* Progress bars: ``for x in progress(items, desc=...)`` (quiet unless stderr is a TTY).
+  Logging: ``logging.getLogger(__name__)``; ``hpfebe run`` shows INFO on stderr.
+* Numerics belong in the core (``hpfebe``); plotting in the experiment (matplotlib,
+  Agg backend is set by the CLI; create figures with ``matplotlib.figure.Figure`` or
+  ``plt.subplots`` - the CLI closes them after writing).
+
+Running: ``hpfebe run <artefact> [--quick]`` (the whole module runs and writes all its
+artefacts), or ``snakemake -j2`` for everything.  ``experiments/bem_laplace.py`` is a
+complete small example.
+"""
