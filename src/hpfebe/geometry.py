@@ -14,8 +14,6 @@ counter-clockwise itself.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Iterable, Sequence
-
 import numpy as np
 from numba import njit
 
@@ -271,9 +269,12 @@ class BoundaryMesh:
 
     @property
     def diameter(self) -> float:
+        """Largest distance between two nodes (attained at vertices of the convex hull)."""
+        from scipy.spatial import ConvexHull
+
         used = self.nodes[np.unique(self.elements)]
-        return float(np.max(np.linalg.norm(used[:, None, :] - used[None, :, :], axis=2))
-                     if len(used) < 4000 else np.linalg.norm(np.ptp(used, axis=0)))
+        hull = used[ConvexHull(used).vertices]
+        return float(np.max(np.linalg.norm(hull[:, None, :] - hull[None, :, :], axis=2)))
 
     def points(self, elem, t) -> np.ndarray:
         """Physical points of reference coordinates ``t`` in [-1, 1] on elements ``elem``."""

@@ -160,8 +160,24 @@ def _assemble(kernel, logc, haslog, kp, d, nodes, elements, normals,
                         for c2 in range(d):
                             v = blk[k * d + c1, l * d + c2]
                             out[gk * d + c1, gl * d + c2] += v
-                            if symmetric and j != i:
-                                out[gl * d + c2, gk * d + c1] += v
+    if symmetric:
+        # dofs of W_hp grow with the element index, so the pairs j >= i filled the upper
+        # triangle; mirror it in cache-sized tiles (a column-wise mirror inside the pair
+        # loop costs a cache miss per entry once the matrix outgrows the cache)
+        _mirror_upper(out)
+
+
+@njit(cache=True, parallel=True)
+def _mirror_upper(A):
+    """A[r, c] = A[c, r] for r > c, tile by tile."""
+    n = A.shape[0]
+    bs = 64
+    nb = (n + bs - 1) // bs
+    for bi in prange(nb):
+        for bj in range(bi + 1):
+            for r in range(bi * bs, min(n, (bi + 1) * bs)):
+                for c in range(bj * bs, min(r, (bj + 1) * bs)):
+                    A[r, c] = A[c, r]
 
 
 NTAB = 12  # far pairs needing fewer Gauss points than this use tabulated basis values
@@ -256,3 +272,32 @@ def local_block(kernel, logc, kp, mesh, i: int, j: int, test_kind: int, trial_ki
     mr = (pr if trial_kind == 0 else pr + 1) * d
     return blk[:mt, :mr].copy()
 
+
+
+@njit(cache=True, parallel=True)
+def _sandwich(indptr, indices, data, V, out):
+    """out = R V R^T for R in CSR (rows of R = rows of out); only j >= i, mirrored."""
+    n = out.shape[0]
+    for idx in prange(n):
+        i = idx // 2 if idx % 2 == 0 else n - 1 - idx // 2   # balance the triangle
+        for j in range(i, n):
+            acc = 0.0
+            for a in range(indptr[i], indptr[i + 1]):
+                k = indices[a]
+                s = 0.0
+                for b in range(indptr[j], indptr[j + 1]):
+                    s += V[k, indices[b]] * data[b]
+                acc += data[a] * s
+            out[i, j] = acc
+            out[j, i] = acc
+
+
+def sandwich(T, V: np.ndarray) -> np.ndarray:
+    """T^T V T for sparse T (n_W x n_V) and dense symmetric V (n_W x n_W), exactly
+    symmetric: the hypersingular operator W = T^T V T from the single layer V of the
+    arc-length derivatives (T: :meth:`ContinuousSpace.derivative_matrix`)."""
+    R = T.T.tocsr()
+    R.sort_indices()
+    out = np.empty((R.shape[0], R.shape[0]))
+    _sandwich(R.indptr, R.indices, R.data, np.ascontiguousarray(V), out)
+    return out

@@ -22,22 +22,26 @@ Operators (1.4), n the outward normal, traction T_n u = sigma(u) n:
 so that the interior Calderon identity reads V t = (K + 1/2) u and (K + 1/2) kills the
 rigid motions, exactly as in :mod:`hpfebe.bem.laplace`.
 
-Hypersingular operator by integration by parts (no hypersingular quadrature).  For 2D
-elasticity (Steinbach, "Numerical Approximation Methods for Elliptic Boundary Value
-Problems", Springer 2008, Section 6.6, the 2D counterpart of the 3D formula (6.24);
-also Han, "A new class of variational formulations for the coupling of finite and
-boundary element methods", J. Comput. Math. 8 (1990)) the bilinear form is
+Hypersingular operator by integration by parts (no hypersingular quadrature).  In 2D the
+Lame hypersingular operator is a composition of tangential derivatives and a single-layer
+type potential (Hsiao & Wendland, "Boundary Integral Equations", Springer 2008,
+Lemma 2.3.1; Steinbach, "Numerical Approximation Methods for Elliptic Boundary Value
+Problems", Springer 2008, chapter on linear elastostatics, for the 3D analogue):
 
     <W u, v> = int int (dv/ds)(x)^T  Vt(x - y)  (du/ds)(y) ds_y ds_x,
     Vt(r)    = E' / (4 pi) { -log(|r| / R) I + r r^T / |r|^2 },
     E'       = 4 mu (lambda + mu) / (lambda + 2 mu)   (= E / (1 - nu^2) in plane strain),
 
-i.e. 4 mu^2 times the fundamental solution with (3 - 4 nu) replaced by 1.  Galerkin:
-W = T^T Vt T with T the exact derivative matrix of :mod:`hpfebe.spaces` (per component)
-and Vt assembled on W_hp by the same :func:`assemble` as V.  The constant R is
-irrelevant here (tangential derivatives have zero mean on closed curves).  Verified in
-tests/test_lame.py through the Calderon identity W u = (1/2 - K') t for Kelvin fields,
-the rigid motions in ker W and the patch test of S_hat.
+i.e. 4 mu^2 times the fundamental solution with (3 - 4 nu) replaced by 1.  How the two
+coefficients are pinned down (and checked in tests/test_lame.py): the log coefficient by
+the symbol of W on a straight line (E'|xi|/4, half the symbol of the half-plane
+Dirichlet-to-Neumann map); the r r^T coefficient by the rigid rotation, whose tangential
+derivative is -n and which must lie in ker W (it does to 1e-15 only with this
+coefficient); the whole operator by the Calderon identity W u = (1/2 - K') t for Kelvin
+fields (converging exponentially in p) and by the exact patch test of S_hat.
+Galerkin: W = T^T Vt T with T the exact derivative matrix of :mod:`hpfebe.spaces` (per
+component) and Vt assembled on W_hp by the same :func:`assemble` as V.  The constant R is
+irrelevant here (tangential derivatives have zero mean on closed curves).
 
 Vector functions are interleaved: global index = 2 * scalar dof + component.
 
@@ -58,87 +62,22 @@ from __future__ import annotations
 import math
 
 import numpy as np
-import scipy.linalg as sla
 import scipy.sparse as sp
-from numba import njit
 
 from ..geometry import BoundaryMesh
 from ..spaces import ContinuousSpace, DiscontinuousSpace
-from .assembly import assemble, local_block
-from .potentials import evaluate_potential
+from .assembly import assemble, local_block, sandwich
+from .kernels import LAME_DL, LAME_HS, LAME_SL
+from .operators import BoundaryOperators
+from .potentials import (POT_LAME_DL, POT_LAME_DL_GRAD, POT_LAME_SL, POT_LAME_SL_GRAD,
+                         evaluate_potential)
 
 PLANES = ("strain", "stress")
 
 
-# ----------------------------------------------------------------------------- kernels
-# Kernels follow the batched interface of :mod:`hpfebe.bem.integration`:
-# kernel(rx, ry, npts, n_x, n_y, kp, out) fills out[q, c1*2 + c2] for q < npts.
-# kp layout: [c1 log R, c1 c2, lambda, mu, c1, c2, Et log R, Et], Et = E'/(4 pi)
-@njit(cache=True, inline="always")
-def _log_rr(rx, ry, a0, a1, out):
-    """a0 I + a1 r r^T / |r|^2 into out[0:4]."""
-    f = a1 / (rx * rx + ry * ry)
-    out[0] = a0 + f * rx * rx
-    out[1] = f * rx * ry
-    out[2] = out[1]
-    out[3] = a0 + f * ry * ry
-
-
-@njit(cache=True, inline="always")
-def _traction_of_G(rx, ry, ny0, ny1, lam, mu, c1, c2, out):
-    """K_ik(x, y) = [sigma_y(G(x, .) e_i) n_y]_k at r = x - y into out[0:4] (degree -1;
-    on a straight element only its odd Cauchy part survives: principal value)."""
-    r2 = rx * rx + ry * ry
-    for i in range(2):
-        ri = rx if i == 0 else ry
-        e0 = 1.0 if i == 0 else 0.0
-        e1 = 1.0 - e0
-        # D_jl = d v_j / d y_l for v = G(x, .) e_i, with d/dy = -d/dr and
-        # dG_ji/dr_l = c1 (-d_ij r_l + c2 (d_il r_j + d_jl r_i) - 2 c2 r_i r_j r_l/|r|^2)/|r|^2
-        g = 2.0 * c2 * ri / r2
-        d00 = -c1 * (-e0 * rx + c2 * (e0 * rx + ri) - g * rx * rx) / r2
-        d01 = -c1 * (-e0 * ry + c2 * e1 * rx - g * rx * ry) / r2
-        d10 = -c1 * (-e1 * rx + c2 * e0 * ry - g * ry * rx) / r2
-        d11 = -c1 * (-e1 * ry + c2 * (e1 * ry + ri) - g * ry * ry) / r2
-        div = d00 + d11
-        s00 = lam * div + 2.0 * mu * d00
-        s11 = lam * div + 2.0 * mu * d11
-        s01 = mu * (d01 + d10)
-        out[i * 2 + 0] = s00 * ny0 + s01 * ny1
-        out[i * 2 + 1] = s01 * ny0 + s11 * ny1
-
-
-@njit(cache=True)
-def single_layer_kernel(rx, ry, npts, nx, ny, kp, out):
-    """Regular part of G: c1 log R I + c1 c2 r r^T / |r|^2 (degree 0); the log part
-    -c1 log|r| I is ``logc``."""
-    for q in range(npts):
-        _log_rr(rx[q], ry[q], kp[0], kp[1], out[q])
-
-
-@njit(cache=True)
-def double_layer_kernel(rx, ry, npts, nx, ny, kp, out):
-    """Traction of G with respect to y, (1.4): K_ik = [sigma_y(G e_i) n_y]_k."""
-    for q in range(npts):
-        _traction_of_G(rx[q], ry[q], ny[0], ny[1], kp[2], kp[3], kp[4], kp[5], out[q])
-
-
-@njit(cache=True)
-def hypersingular_kernel(rx, ry, npts, nx, ny, kp, out):
-    """Regular part of Vt: E'/(4 pi) (log R I + r r^T/|r|^2); log part -E'/(4 pi) log|r| I."""
-    for q in range(npts):
-        _log_rr(rx[q], ry[q], kp[6], kp[7], out[q])
-
-
-# potential kernels (points off Gamma, see potentials.py): full kernel including the log
-@njit(cache=True, inline="always")
-def _pot_single(rx, ry, ny0, ny1, kp, out):
-    _log_rr(rx, ry, kp[0] - 0.5 * kp[4] * math.log(rx * rx + ry * ry), kp[1], out)
-
-
-@njit(cache=True, inline="always")
-def _pot_double(rx, ry, ny0, ny1, kp, out):
-    _traction_of_G(rx, ry, ny0, ny1, kp[2], kp[3], kp[4], kp[5], out)
+# The Lame kernels (regular parts) live in kernels.py as LAME_SL, LAME_DL, LAME_HS: the
+# assemblers take kernel ids.  kp layout (kernel_params):
+# [c1 log R, c1 c2, lambda, mu, c1, c2, Et log R, Et], Et = E'/(4 pi).
 
 
 def lame_constants(E: float, nu: float, plane: str = "strain") -> tuple[float, float]:
@@ -160,6 +99,7 @@ def lame_constants(E: float, nu: float, plane: str = "strain") -> tuple[float, f
 
 
 def kernel_params(lam: float, mu: float, scale: float) -> np.ndarray:
+    """Parameter array kp shared by all Lame kernels (layout in the comment above)."""
     c1 = (lam + 3.0 * mu) / (4.0 * math.pi * mu * (lam + 2.0 * mu))
     c2 = (lam + mu) / (lam + 3.0 * mu)
     Et = 4.0 * mu * (lam + mu) / (lam + 2.0 * mu) / (4.0 * math.pi)
@@ -181,7 +121,7 @@ def _kron2(A):
     return np.kron(A, np.eye(2))
 
 
-class LameBEM:
+class LameBEM(BoundaryOperators):
     """Galerkin boundary element operators of 2D linear elasticity on one boundary mesh.
 
     Parameters
@@ -194,31 +134,21 @@ class LameBEM:
 
     Matrices (interleaved components, assembled on first use, cached): ``V`` (W_hp^2 x
     W_hp^2), ``K`` (test W_hp^2, trial V_hp^2), ``K_adj``, ``W`` (V_hp^2 x V_hp^2), ``M``,
-    ``B = K + M/2``, ``S_hat``; ``Psi(U)`` the discrete traction.
+    ``B = K + M/2``, ``S_hat``; ``Psi(U)`` the discrete traction.  Post-processing at
+    interior points: ``representation`` (Somigliana), ``displacement_gradient``, ``stress``.
     """
 
     d = 2
 
     def __init__(self, mesh: BoundaryMesh, E: float, nu: float, plane: str = "strain",
                  scale: float | None = None, zero_force: bool = True):
-        if not isinstance(mesh, BoundaryMesh):
-            raise ValueError(f"mesh must be a BoundaryMesh, got {type(mesh).__name__}")
-        self.mesh = mesh
         self.E, self.nu, self.plane = float(E), float(nu), plane
         self.lam, self.mu = lame_constants(E, nu, plane)
-        self.scale = float(2.0 * mesh.diameter if scale is None else scale)
-        if not (math.isfinite(self.scale) and self.scale > 0):
-            raise ValueError(f"scale must be positive, got {scale!r}")
-        self.zero_force = bool(zero_force)
+        if isinstance(mesh, BoundaryMesh) and scale is None:
+            scale = 2.0 * mesh.diameter
+        super().__init__(mesh, scale, constrained=zero_force)
+        self.zero_force = self.constrained
         self.kp = kernel_params(self.lam, self.mu, self.scale)
-        self.W_space = DiscontinuousSpace(mesh)
-        self.V_space = ContinuousSpace(mesh)
-        self._cache: dict[str, object] = {}
-
-    def _get(self, name, build):
-        if name not in self._cache:
-            self._cache[name] = build()
-        return self._cache[name]
 
     @property
     def c1(self) -> float:
@@ -233,20 +163,15 @@ class LameBEM:
     @property
     def V(self) -> np.ndarray:
         """Single layer (1.4), W_hp^2 x W_hp^2, symmetric positive definite."""
-        return self._get("V", lambda: assemble(single_layer_kernel, _logc(self.c1), self.kp,
+        return self._get("V", lambda: assemble(LAME_SL, _logc(self.c1), self.kp,
                                                self.W_space, self.W_space, d=2,
                                                symmetric=True))
 
     @property
     def K(self) -> np.ndarray:
         """Double layer (1.4), test W_hp^2, trial V_hp^2."""
-        return self._get("K", lambda: assemble(double_layer_kernel, NO_LOG, self.kp,
+        return self._get("K", lambda: assemble(LAME_DL, NO_LOG, self.kp,
                                                self.W_space, self.V_space, d=2))
-
-    @property
-    def K_adj(self) -> np.ndarray:
-        """Adjoint double layer K' = K^T (V_hp^2 x W_hp^2)."""
-        return self.K.T
 
     @property
     def T(self):
@@ -261,34 +186,14 @@ class LameBEM:
     @property
     def Vt(self) -> np.ndarray:
         """Single-layer-type matrix of the hypersingular kernel Vt on W_hp^2."""
-        return self._get("Vt", lambda: assemble(hypersingular_kernel, _logc(self.Et), self.kp,
+        return self._get("Vt", lambda: assemble(LAME_HS, _logc(self.Et), self.kp,
                                                 self.W_space, self.W_space, d=2,
                                                 symmetric=True))
 
     @property
     def W(self) -> np.ndarray:
         """Hypersingular operator, V_hp^2 x V_hp^2: <W U, U'> = <Vt dU/ds, dU'/ds>."""
-        def build():
-            T = self.T
-            W = T.T @ (T.T @ self.Vt.T).T
-            return 0.5 * (W + W.T)
-        return self._get("W", build)
-
-    @property
-    def B(self) -> np.ndarray:
-        """K + M/2 (test W_hp^2, trial V_hp^2): right-hand side of V Psi = B U."""
-        return self._get("B", lambda: self.K + 0.5 * self.M.toarray())
-
-    @property
-    def V_cho(self):
-        def build():
-            try:
-                return sla.cho_factor(self.V, lower=True)
-            except np.linalg.LinAlgError as exc:
-                raise np.linalg.LinAlgError(
-                    "V is not positive definite: increase the kernel scale "
-                    f"(scale={self.scale})") from exc
-        return self._get("V_cho", build)
+        return self._get("W", lambda: sandwich(self.T, self.Vt))
 
     @property
     def m(self) -> np.ndarray:
@@ -299,34 +204,20 @@ class LameBEM:
         return self._get("m", build)
 
     @property
-    def S_hat(self) -> np.ndarray:
-        """Discrete Steklov-Poincare operator W + B^T V^{-1} B (Section 1.4), symmetric;
-        with ``zero_force`` restricted to zero-total-force tractions (scale invariant)."""
-        def build():
-            c, lower = self.V_cho
-            Y = sla.solve_triangular(c, self.B, lower=lower)
-            S = self.W + Y.T @ Y
-            if self.zero_force:
-                Z = sla.solve_triangular(c, self.m, lower=lower)
-                YZ = Y.T @ Z
-                S -= YZ @ np.linalg.solve(Z.T @ Z, YZ.T)
-            return 0.5 * (S + S.T)
-        return self._get("S_hat", build)
-
-    def Psi(self, U) -> np.ndarray:
-        """Discrete traction Psi = V^{-1} (K + M/2) U in W_hp^2 (Section 1.4), with zero
-        total force if ``zero_force``."""
-        psi = sla.cho_solve(self.V_cho, self.B @ np.asarray(U))
-        if self.zero_force:
-            Wm = self._get("w_eq", lambda: sla.cho_solve(self.V_cho, self.m))
-            psi = psi - Wm @ np.linalg.solve(self.m.T @ Wm, self.m.T @ psi)
-        return psi
+    def constraints(self) -> np.ndarray:
+        return self.m
 
     # --------------------------------------------------------------- post-processing
     def representation(self, points, U, psi) -> np.ndarray:
         """Somigliana's identity (1.2) with f = 0 at interior points, shape (n, 2):
         u(x) = int G(x,y) psi(y) ds_y - int (T_{n_y} G(x,y)^T) U(y) ds_y,
         ``U`` in V_hp^2, ``psi`` in W_hp^2 (interleaved)."""
+        pts, U, psi = self._check_cauchy(points, U, psi)
+        u = evaluate_potential(POT_LAME_SL, self.kp, 2, pts, self.W_space, psi)
+        u -= evaluate_potential(POT_LAME_DL, self.kp, 2, pts, self.V_space, U)
+        return u
+
+    def _check_cauchy(self, points, U, psi):
         pts = np.ascontiguousarray(np.atleast_2d(np.asarray(points, dtype=float)))
         if pts.ndim != 2 or pts.shape[1] != 2:
             raise ValueError(f"points must have shape (n, 2), got {pts.shape}")
@@ -334,9 +225,22 @@ class LameBEM:
         psi = np.asarray(psi, dtype=float).reshape(-1, 2)
         if U.shape[0] != self.V_space.ndof or psi.shape[0] != self.W_space.ndof:
             raise ValueError("U must have 2 * V_space.ndof and psi 2 * W_space.ndof entries")
-        u = evaluate_potential(_pot_single, self.kp, 2, pts, self.W_space, psi)
-        u -= evaluate_potential(_pot_double, self.kp, 2, pts, self.V_space, U)
-        return u
+        return pts, U, psi
+
+    def displacement_gradient(self, points, U, psi) -> np.ndarray:
+        """du_i/dx_m at interior points, shape (n, 2, 2): the x-gradient of Somigliana's
+        identity (1.2) (kernels differentiated analytically, hpfebe.bem.potentials)."""
+        pts, U, psi = self._check_cauchy(points, U, psi)
+        g = evaluate_potential(POT_LAME_SL_GRAD, self.kp, 2, pts, self.W_space, psi, nout=4)
+        g -= evaluate_potential(POT_LAME_DL_GRAD, self.kp, 2, pts, self.V_space, U, nout=4)
+        return g.reshape(-1, 2, 2)
+
+    def stress(self, points, U, psi) -> np.ndarray:
+        """Stress sigma(u) = lambda tr eps I + 2 mu eps at interior points, (n, 2, 2)
+        (lambda = lambda* in plane stress)."""
+        g = self.displacement_gradient(points, U, psi)
+        div = g[:, 0, 0] + g[:, 1, 1]
+        return self.lam * div[:, None, None] * np.eye(2) + self.mu * (g + np.swapaxes(g, 1, 2))
 
 
 def local_blocks(mesh: BoundaryMesh, i: int, j: int, E: float, nu: float,
@@ -346,9 +250,9 @@ def local_blocks(mesh: BoundaryMesh, i: int, j: int, E: float, nu: float,
     W = T_i^T Vt_ij T_j (GLL^2 x GLL^2).  For tests."""
     lam, mu = lame_constants(E, nu, plane)
     kp = kernel_params(lam, mu, scale)
-    V = local_block(single_layer_kernel, _logc(kp[4]), kp, mesh, i, j, 0, 0, d=2)
-    K = local_block(double_layer_kernel, NO_LOG, kp, mesh, i, j, 0, 1, d=2)
-    Vt = local_block(hypersingular_kernel, _logc(kp[7]), kp, mesh, i, j, 0, 0, d=2)
+    V = local_block(LAME_SL, _logc(kp[4]), kp, mesh, i, j, 0, 0, d=2)
+    K = local_block(LAME_DL, NO_LOG, kp, mesh, i, j, 0, 1, d=2)
+    Vt = local_block(LAME_HS, _logc(kp[7]), kp, mesh, i, j, 0, 0, d=2)
     Ts = []
     for e in (i, j):
         p = int(mesh.degrees[e])

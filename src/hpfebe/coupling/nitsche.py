@@ -31,16 +31,13 @@ alpha = 2 or h_def="diameter" change the p = 2, 3 errors by 10-60 % (experiments
 record the comparison).  alpha = 2, the choice that makes the bound of Lemma 2.2.3
 p-independent, is available as a parameter.
 
-Solver (``solve``): the FE block is large and sparse, S_hat is small and dense.  We
-factorise the FE block K11 once per lambda with a sparse LU and condense onto the BE dofs
-(static condensation / Schur complement)
-
-    (K22 - K21 K11^-1 K12) U2 = f2 - K21 K11^-1 f1,     K11 U1 = f1 - K12 U2,
-
-where K11^-1 K12 is needed only for the columns of the BE dofs on Gamma_I (K12 is zero
-elsewhere), formed in chunks so that no dense n1 x n2 array is kept.  The FE block is never
-densified; the dense part is the n2 x n2 BE Schur complement, solved by LU.  The residual of
-the full system is computed and returned; a singular or ill-conditioned solve raises.
+Solver (``solve``): the FE block is large and sparse, S_hat is small and dense.  The whole
+system is factorised once per lambda by a sparse LU with the n2 x n2 BE block stored as a
+dense block inside the sparse matrix: the FE block is never densified, and the fill the
+dense block causes stays within its n2 rows and columns.  (Static condensation onto the BE
+dofs needs one FE solve per coupled BE dof: 4.5 s against 1.2 s for this direct solve on
+Example 1, p = 3, FE h = 1/47, BE h = 1/48, 60206 + 431 dofs.)  The residual of the full
+system is computed and returned; a singular or inaccurate solve raises.
 """
 
 from __future__ import annotations
@@ -50,7 +47,6 @@ import time
 from dataclasses import dataclass, field
 
 import numpy as np
-import scipy.linalg as sla
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
@@ -214,30 +210,18 @@ class NitscheFEBE:
             raise ValueError(f"lambda_Nit must be a finite number >= 0, got {lam!r}")
         return lam
 
-    def solve(self, lam: float = DEFAULT_LAMBDA, chunk: int = 256) -> NitscheSolution:
-        """Solve (2.3) by static condensation onto the BE dofs (module doc)."""
+    def solve(self, lam: float = DEFAULT_LAMBDA) -> NitscheSolution:
+        """Solve (2.3) by one sparse LU of the coupled system (module doc)."""
         t0 = time.perf_counter()
         K11, K12, K22 = self.blocks(lam)
-        try:
-            lu = spla.splu(K11)
-        except RuntimeError as exc:
-            raise np.linalg.LinAlgError(f"FE block singular for lambda_Nit={lam}: {exc}") \
-                from exc
         K21 = K12.T.tocsr()
-        cols = np.flatnonzero(np.diff(K12.indptr))   # BE dofs coupled to the FE part
-        schur = K22.copy()
-        for s in range(0, len(cols), chunk):
-            c = cols[s:s + chunk]
-            X = lu.solve(K12[:, c].toarray())
-            schur[:, c] -= K21 @ X
-        g1 = lu.solve(self.b1)
-        rhs2 = self.b2 - K21 @ g1
         try:
-            lu2 = sla.lu_factor(schur, check_finite=True)
-        except (ValueError, sla.LinAlgError) as exc:
-            raise np.linalg.LinAlgError(f"BE Schur complement singular: {exc}") from exc
-        U2 = sla.lu_solve(lu2, rhs2)
-        U1 = lu.solve(self.b1 - K12 @ U2)
+            lu = spla.splu(self.matrix(lam).tocsc())
+        except RuntimeError as exc:
+            raise np.linalg.LinAlgError(f"coupled system singular for lambda_Nit={lam}: "
+                                        f"{exc}") from exc
+        x = lu.solve(np.concatenate([self.b1, self.b2]))
+        U1, U2 = x[:self.n1], x[self.n1:]
         r1 = K11 @ U1 + K12 @ U2 - self.b1
         r2 = K21 @ U1 + K22 @ U2 - self.b2
         bnorm = np.sqrt(self.b1 @ self.b1 + self.b2 @ self.b2)
@@ -252,5 +236,5 @@ class NitscheFEBE:
         full2 = np.zeros(self.bem.V_space.ndof)
         full2[self.free2] = U2
         info = {"residual": res, "solve_s": time.perf_counter() - t0, "n_fe": self.n1,
-                "n_be": self.n2, "n_schur_cols": int(len(cols)), **self.timings}
+                "n_be": self.n2, **self.timings}
         return NitscheSolution(float(lam), full1, full2, info)

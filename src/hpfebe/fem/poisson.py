@@ -121,7 +121,7 @@ class PoissonFE:
         gy = np.empty_like(val)
         for k in range(nb):
             f = self.element.gbasis(mapping, X, k, tind=cells)[0]
-            val[k] = f.value[:, 0]
+            val[k] = np.asarray(f)[:, 0]
             gx[k] = f.grad[0][:, 0]
             gy[k] = f.grad[1][:, 0]
         rows = np.tile(np.arange(pts.shape[0]), nb)

@@ -1,0 +1,333 @@
+"""Chapter 2, Section 2.2.5, Examples 1 and 2: convergence of hp-Nitsche FE/BE coupling.
+
+Weak form (2.3)-(2.4) with lambda_Nit = 10, solved by hpfebe.coupling.NitscheFEBE.
+Example 1 (smooth, (2.10)-(2.12)): h-version p1 = p2 = 1, 2, 3 with FE h^-1 = 2, 5, 11, 23,
+47 and BE h^-1 = 3, 6, 12, 24, 48 (Tables 2.1, 2.2); p-version on FE h = 1/5 (75 elements)
+and BE h = 1/6 (24 elements), p1 = p2 = 1..8, against the h-version p = 2 (Figure 2.2).
+Example 2 (singular, (2.13)-(2.15)): h-version p = 1, FE h^-1 = 4..256, BE h^-1 = 8..260;
+p-version p = 1..7 on FE h^-1 = 4, BE h^-1 = 6 (Tables 2.3, 2.4; Figure 2.4).
+Figures 2.1 and 2.3: the computed solutions.  Beyond the thesis: error against wall time
+(figure_work_precision_ch2) for the h-version p = 1, 2, 3 and the p-version of both
+examples.
+
+Choices where the thesis is silent (each checked against the printed numbers):
+* alpha = 0 in the penalty lambda_Nit h1^-1 p1^alpha, and h1 = the length of the FE edge
+  on Gamma_I (not diam K): with them Table 2.2 (h^-1 = 2, p = 1, 2, 3) and Table 2.4 (h- and
+  p-version) are reproduced to the printed digits.
+* FE meshes: per-block tensor grids with the cell count of the uniform grid; in Example 1
+  the blocks y in [-1,-1/2] / [1/2,1] of odd h^-1 get floor/ceil(h^-1/2) rows (75 elements
+  for h = 1/5 as in the thesis).  BE meshes: ceil(|side| h^-1) equal elements per side.
+* The p-version of Example 2 uses FE h^-1 = 4 and BE h^-1 = 6 (the table headers), not the
+  h1 = 1/6, h2 = 1/8 of the caption of Figure 2.4: the FE errors of Table 2.4 are then
+  reproduced exactly for p = 1..7.
+* BE-part errors: domain L2 / H1-seminorm errors in Omega2 of the Q_p equidistant-node
+  interpolant, on a mesh of Omega2 of the BE mesh size, of the representation-formula
+  solution (nodal values U2 on dOmega2): the measure that reproduces Table 2.1 and the
+  h-version of Table 2.3 (hpfebe.coupling.errors explains why other measures do not).
+* Rates: log(e_prev/e)/log(h_prev/h); for the p-series log(e_prev/e)/log(p/p_prev).
+* DOF = FE + BE unknowns without Gamma_D.
+"""
+
+from __future__ import annotations
+
+import logging
+import time
+
+import numpy as np
+import pandas as pd
+from matplotlib.figure import Figure
+from matplotlib.tri import Triangulation
+
+from hpfebe.coupling import NitscheFEBE, problem
+from hpfebe.results import ArtefactResult, Claim
+
+from experiments._ch2 import add_slope, compare, part_table, sweep
+
+ARTEFACTS = ("table_2_1", "table_2_2", "table_2_3", "table_2_4", "figure_2_1", "figure_2_2",
+             "figure_2_3", "figure_2_4", "figure_work_precision_ch2")
+
+log = logging.getLogger(__name__)
+
+TOL = {"l2_error": ("factor", 2.0), "h1_error": ("factor", 2.0),
+       "l2_rate": ("abs", 0.15), "h1_rate": ("abs", 0.15)}
+TOL_SINGULAR = {"l2_error": ("factor", 2.0), "h1_error": ("factor", 2.0),
+                "l2_rate": ("abs", 0.15), "h1_rate": ("abs", 0.1)}
+
+
+def _published(name):
+    from pathlib import Path
+    root = Path(__file__).resolve().parents[1]
+    return pd.read_csv(root / "report" / "published" / name, comment="#")
+
+
+def _last(table, series, p, col):
+    g = table[(table.series == series) & (table.p == p)] if series == "h" else \
+        table[table.series == series]
+    return float(g[col].iloc[-1])
+
+
+def _solution_figure(name, fe_h, be_h, title):
+    """Computed solution: U1 on the FE mesh (p = 1), I_h u~ of the BE part on Omega2."""
+    pb = problem(name)
+    model = NitscheFEBE(pb, fe_h, be_h, 1)
+    sol = model.solve(10.0)
+    m = model.domain.mesh
+    tri = np.vstack([m.t[[0, 1, 2]].T, m.t[[0, 2, 3]].T])
+    fig = Figure(figsize=(6.0, 5.0))
+    ax = fig.subplots()
+    vmin, vmax = 0.0, float(np.max(sol.U1))
+    pc = ax.tripcolor(Triangulation(m.p[0], m.p[1], tri), sol.U1[:m.p.shape[1]],
+                      shading="gouraud", vmin=vmin, vmax=vmax, cmap="viridis")
+    d2 = pb.omega2_domain(2 * be_h).mesh
+    cent = d2.p[:, d2.t].mean(axis=1).T
+    psi = model.bem.Psi(sol.U2)
+    vals = np.empty(d2.p.shape[1])
+    inner = np.ones(d2.p.shape[1], dtype=bool)
+    from hpfebe.coupling.errors import _boundary_values
+    bv = _boundary_values(model, sol.U2, d2.p.T)
+    inner = np.isnan(bv)
+    vals[~inner] = bv[~inner]
+    vals[inner] = model.bem.representation(d2.p.T[inner], sol.U2, psi)
+    tri2 = np.vstack([d2.t[[0, 1, 2]].T, d2.t[[0, 2, 3]].T])
+    ax.tripcolor(Triangulation(d2.p[0], d2.p[1], tri2), vals, shading="gouraud",
+                 vmin=vmin, vmax=vmax, cmap="viridis")
+    a = model.be_mesh
+    ax.plot(np.r_[a.a[:, 0], a.a[0, 0]], np.r_[a.a[:, 1], a.a[0, 1]], "w-", lw=1.2)
+    ax.set_aspect("equal")
+    ax.set_title(title, fontsize=9)
+    fig.colorbar(pc, ax=ax, shrink=0.8)
+    ax.text(0.02, 0.02, r"$\Omega_1$: FE ($h^{-1}$=%g), $\Omega_2$: BE ($h^{-1}$=%g), "
+            "white: $\\partial\\Omega_2$" % (fe_h, be_h), transform=ax.transAxes, fontsize=7,
+            color="w")
+    return fig, float(min(sol.U1.min(), vals.min())), float(max(sol.U1.max(), vals.max()))
+
+
+def _convergence_figure(h, pv, xlabel_h, title, slopes):
+    fig = Figure(figsize=(7.0, 5.0))
+    ax = fig.subplots()
+    for df, tag, mk in ((h, "h", "o-"), (pv, "p", "s--")):
+        for part in ("be", "fe"):
+            for norm, nm in (("h1", "energy-err"), ("l2", "L2-error")):
+                ax.loglog(df.dof, df[f"{part}_{norm}"], mk, ms=4,
+                          label=f"{tag}: {nm} ({part.upper()})")
+    for s, y0, lab in slopes:
+        add_slope(ax, h.dof, y0, s, lab)
+    ax.set_xlabel("DOF")
+    ax.set_ylabel("error")
+    ax.set_title(title, fontsize=9)
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=6, ncol=2)
+    return fig
+
+
+def run(config: dict, quick: bool = False) -> list[ArtefactResult]:
+    lam = float(config.get("lambda_nit", 10.0))
+    alpha = float(config.get("alpha", 0.0))
+    h_def = str(config.get("h_def", "edge"))
+    sm = config.get("smooth", {})
+    sg = config.get("singular", {})
+    t_all = time.perf_counter()
+
+    # ---------------------------------------------------------------- Example 1
+    pairs = [tuple(x) for x in sm.get("h_pairs", [[2, 3], [5, 6], [11, 12], [23, 24],
+                                                  [47, 48]])]
+    degrees = [int(p) for p in sm.get("degrees", [1, 2, 3])]
+    max_fe_h = {int(k): v for k, v in sm.get("max_fe_h_inv", {}).items()}
+    cases = [(fh, bh, p) for p in degrees for fh, bh in pairs
+             if fh <= max_fe_h.get(p, np.inf)]
+    t0 = time.perf_counter()
+    jit0 = time.perf_counter()
+    NitscheFEBE(problem("smooth"), 2, 3, 1).solve(lam)       # numba compile / cache load
+    jit_s = time.perf_counter() - jit0
+    sm_h = sweep("smooth", "h", cases, [lam], alpha, h_def)
+    pf, pb_ = sm.get("p_mesh", [5, 6])
+    sm_p = sweep("smooth", "p", [(pf, pb_, p) for p in sm.get("p_degrees", range(1, 9))],
+                 [lam], alpha, h_def)
+    t_smooth = time.perf_counter() - t0
+
+    # ---------------------------------------------------------------- Example 2
+    t0 = time.perf_counter()
+    spairs = [tuple(x) for x in sg.get("h_pairs", [[4, 8], [8, 12], [16, 20], [32, 36],
+                                                   [64, 68], [128, 132], [256, 260]])]
+    sg_h = sweep("singular", "h", [(fh, bh, 1) for fh, bh in spairs], [lam], alpha, h_def)
+    qf, qb = sg.get("p_mesh", [4, 6])
+    sg_p = sweep("singular", "p", [(qf, qb, p) for p in sg.get("p_degrees", range(1, 8))],
+                 [lam], alpha, h_def)
+    t_singular = time.perf_counter() - t0
+
+    meta = dict(jit_s=round(jit_s, 2), smooth_s=round(t_smooth, 2),
+                singular_s=round(t_singular, 2), run_s=round(time.perf_counter() - t_all, 2),
+                lambda_nit=lam, alpha=alpha, h_def=h_def)
+    tmeta = dict(meta, allow_nan_columns=["l2_rate", "h1_rate"])
+    common_notes = (
+        f"lambda_Nit = {lam}, alpha = {alpha:g}, h1 = {h_def} length of the FE element on "
+        "Gamma_I. BE part: domain errors in Omega2 of the Q_p equidistant interpolant (BE "
+        "mesh size) of the representation-formula solution; FE part: domain errors in "
+        "Omega1. See the module docstring for every choice.")
+    results = []
+
+    # ---------------------------------------------------------------- tables 2.1 / 2.2
+    t21 = part_table(sm_h, "be", "be_h_inv")
+    t22 = part_table(sm_h, "fe", "fe_h_inv")
+    for name, table, pubf, part in (("table_2_1", t21, "table_2_1_nitsche_smooth_h_BE.csv",
+                                     "BE"),
+                                    ("table_2_2", t22, "table_2_2_nitsche_smooth_h_FE.csv",
+                                     "FE")):
+        pub = _published(pubf)
+        claims = []
+        for p in degrees:
+            r_l2, r_h1 = _last(table, "h", p, "l2_rate"), _last(table, "h", p, "h1_rate")
+            ok = abs(r_h1 - p) <= 0.15 and abs(r_l2 - (p + 1)) <= 0.25
+            claims.append(Claim(
+                text=f"{part} part, p={p}: rates ~{p + 1} (L2) and ~{p} (H1_0)",
+                holds=bool(ok),
+                evidence=f"last observed rates L2 {r_l2:.3f}, H1 {r_h1:.3f} (tolerance 0.25 "
+                         "on L2: the thesis's own L2 rates on this non-nested sequence "
+                         "scatter by up to 0.5)"))
+        ratio = pd.concat([compare(table, pub, "l2_error"), compare(table, pub, "h1_error")])
+        claims.append(Claim(
+            text=f"{part} errors reproduce the published Table {name[-3:].replace('_', '.')}",
+            holds=bool(ratio.between(0.5, 2.0).all()),
+            evidence=f"reproduced/published in [{ratio.min():.3f}, {ratio.max():.3f}] over "
+                     f"{len(ratio)} entries"))
+        results.append(ArtefactResult(
+            name=name, table=table, published=pubf, keys=("series", "h_inv", "p"),
+            tolerances=TOL, claims=claims, meta=tmeta,
+            notes=common_notes + " Rates on the thesis's non-nested sequence (h^-1 = 2, 5, "
+            "11, 23, 47) scatter, as in the thesis. The first rate of each sweep is NaN "
+            "(no previous mesh)."))
+
+    # ---------------------------------------------------------------- tables 2.3 / 2.4
+    sg_all = pd.concat([sg_h, sg_p], ignore_index=True)
+    t23 = part_table(sg_all, "be", "be_h_inv")
+    t24 = part_table(sg_all, "fe", "fe_h_inv")
+    r_h = _last(t23, "h", 1, "h1_rate")
+    r_p = _last(t23, "p", None, "h1_rate")
+    l2_h, l2_p = _last(t23, "h", 1, "l2_rate"), _last(t23, "p", None, "l2_rate")
+    claims23 = [
+        Claim("BE energy rate of the h-version ~0.66 (theory 2/3)", abs(r_h - 2 / 3) <= 0.08,
+              f"last h-version H1 rate {r_h:.3f}"),
+        Claim("BE energy rate of the p-version ~0.8 (theory 4/3 - 1/2 = 5/6)",
+              bool(abs(r_p - 0.8) <= 0.1),
+              f"last p-version H1 rate {r_p:.3f} (w.r.t. p). Our p-version BE errors are "
+              "smaller than the published ones for p >= 2 (ratio down to ~0.7 in H1, ~0.2 "
+              "in L2 at p = 7) although the FE errors of the same runs equal Table 2.4 to "
+              "the printed digits; the thesis's BE values probably carry a near-boundary "
+              "quadrature error of the representation formula that grows with p. Our rate "
+              "lies between the 5/6 of Theorem 2.2.3 and the 4/3 of the p-BEM."),
+        Claim("p-version: better energy rate, worse L2 rate than the h-version in Omega2 "
+              "(0.8 vs 0.66, 1.19 vs 1.4)", bool(r_p > r_h and l2_p < l2_h),
+              f"energy {r_p:.3f} vs {r_h:.3f}, L2 {l2_p:.3f} vs {l2_h:.3f}"),
+    ]
+    rf_h = _last(t24, "h", 1, "h1_rate")
+    claims24 = [
+        Claim("FE part H1 rate 1.0 for p = 1 (h-version)", abs(rf_h - 1.0) <= 0.1,
+              f"last h-version FE H1 rate {rf_h:.3f}"),
+        Claim("FE part: the p-version converges significantly faster than the h-version",
+              bool(_last(t24, "p", None, "h1_error") < _last(t24, "h", 1, "h1_error")
+                   and sg_p.dof.max() < sg_h.dof.max()),
+              f"p-version H1 error {_last(t24, 'p', None, 'h1_error'):.3e} with "
+              f"{int(sg_p.dof.max())} DOF vs h-version {_last(t24, 'h', 1, 'h1_error'):.3e} "
+              f"with {int(sg_h.dof.max())} DOF"),
+    ]
+    for name, table, pubf, claims in (
+            ("table_2_3", t23, "table_2_3_nitsche_singular_BE.csv", claims23),
+            ("table_2_4", t24, "table_2_4_nitsche_singular_FE.csv", claims24)):
+        pub = _published(pubf)
+        ratio = pd.concat([compare(table, pub, "l2_error"), compare(table, pub, "h1_error")])
+        claims = list(claims) + [Claim(
+            text="errors within a factor 2 of the published table",
+            holds=bool(ratio.between(0.5, 2.0).all()),
+            evidence=f"reproduced/published in [{ratio.min():.3f}, {ratio.max():.3f}]")]
+        for c in claims:
+            c.holds = bool(c.holds)
+        results.append(ArtefactResult(
+            name=name, table=table, published=pubf, keys=("series", "h_inv", "p"),
+            tolerances=TOL_SINGULAR, claims=claims, meta=tmeta,
+            notes=common_notes + " p-version on FE h^-1 = 4, BE h^-1 = 6 (table headers; "
+            "the caption of Figure 2.4 says 1/6, 1/8). BE p-version rows for p >= 2 differ "
+            "from the thesis (see the claim); the FE rows are exact."))
+
+    # ---------------------------------------------------------------- figures 2.1 / 2.3
+    fig, lo, hi = _solution_figure("smooth", 23, 24, "Example 1: u = (x+1)/((x+1)^2+(y+2)^2)")
+    results.append(ArtefactResult(
+        name="figure_2_1", table=pd.DataFrame([dict(quantity="solution_min", value=lo),
+                                               dict(quantity="solution_max", value=hi)]),
+        figure=fig, claims=[Claim("solution range 0..0.5 (colorbar of Figure 2.1)",
+                                  bool(abs(lo) < 0.02 and abs(hi - 0.5) < 0.02),
+                                  f"computed range {lo:.4f}..{hi:.4f}")],
+        notes="p = 1, FE h^-1 = 23, BE h^-1 = 24, lambda_Nit = 10; Omega2 by the "
+              "representation formula at the nodes of a mesh of size 1/48.", meta=meta))
+    fig, lo, hi = _solution_figure("singular", 32, 36, "Example 2: u = r^(2/3) sin(2 theta/3)")
+    results.append(ArtefactResult(
+        name="figure_2_3", table=pd.DataFrame([dict(quantity="solution_min", value=lo),
+                                               dict(quantity="solution_max", value=hi)]),
+        figure=fig, claims=[Claim("solution range 0..1.260 (colorbar of Figure 2.3)",
+                                  bool(abs(lo) < 0.02 and abs(hi - 1.26) < 0.02),
+                                  f"computed range {lo:.4f}..{hi:.4f}")],
+        notes="p = 1, FE h^-1 = 32, BE h^-1 = 36, lambda_Nit = 10.", meta=meta))
+
+    # ---------------------------------------------------------------- figure 2.2 / 2.4
+    h2 = sm_h[sm_h.p == 2]
+    fig = _convergence_figure(h2, sm_p, "DOF",
+                              f"Example 1: h-version p=2 vs p-version (FE h=1/{pf}, "
+                              f"BE h=1/{pb_})",
+                              [(-1.0, h2.fe_h1.iloc[0], "DOF^-1"),
+                               (-1.5, h2.fe_l2.iloc[0], "DOF^-3/2")])
+    lp = np.log(sm_p.fe_h1.to_numpy())
+    q = np.exp(np.diff(lp))
+    results.append(ArtefactResult(
+        name="figure_2_2", table=pd.concat([h2, sm_p], ignore_index=True), figure=fig,
+        claims=[Claim("the p-version converges exponentially (smooth solution)",
+                      bool(np.all(q < 0.35)),
+                      "FE H1 error ratios per degree: " + ", ".join(f"{v:.3f}" for v in q)
+                      + " (a fixed reduction factor per degree = exponential in p)")],
+        notes=common_notes + f" p-version on FE h^-1 = {pf} (75 elements), BE h^-1 = {pb_} "
+              "(24 elements), p1 = p2.", meta=meta))
+    fig = _convergence_figure(sg_h, sg_p, "DOF", "Example 2: h-version p=1 vs p-version "
+                              f"(FE h=1/{qf}, BE h=1/{qb})",
+                              [(-1 / 3, sg_h.be_h1.iloc[0], "DOF^-1/3"),
+                               (-0.5, sg_h.fe_h1.iloc[0], "DOF^-1/2")])
+    results.append(ArtefactResult(
+        name="figure_2_4", table=sg_all, figure=fig,
+        claims=[claims23[2], claims24[1]], notes=common_notes, meta=meta))
+
+    # ---------------------------------------------------------------- work-precision
+    wp = pd.concat([sm_h, sm_p, sg_h, sg_p], ignore_index=True)
+    fig = Figure(figsize=(10.0, 4.5))
+    axs = fig.subplots(1, 2)
+    for ax, name in zip(axs, ("smooth", "singular")):
+        d = wp[wp.problem == name]
+        for (series, p), g in d.groupby(["series", "p"] if True else []):
+            if series == "p":
+                continue
+            ax.loglog(g.wall_time_s, g.fe_h1 + g.be_h1, "o-", ms=3, label=f"h-version p={p}")
+        g = d[d.series == "p"]
+        ax.loglog(g.wall_time_s, g.fe_h1 + g.be_h1, "s--", ms=3, label="p-version")
+        ax.set_xlabel("wall time (assembly + solve) [s]")
+        ax.set_ylabel("FE + BE energy error")
+        ax.set_title(name, fontsize=9)
+        ax.grid(True, which="both", alpha=0.3)
+        ax.legend(fontsize=7)
+    best = {}
+    for name in ("smooth", "singular"):
+        d = wp[wp.problem == name]
+        target = float((d.fe_h1 + d.be_h1)[d.series == "p"].min()) * 3
+        hit = d[(d.fe_h1 + d.be_h1) <= target]
+        best[name] = hit.sort_values("wall_time_s").iloc[0] if len(hit) else None
+    ev = "; ".join(f"{k}: fastest to reach the target error: {v.series}-version p={v.p} "
+                   f"({v.wall_time_s:.3f} s)" for k, v in best.items() if v is not None)
+    results.append(ArtefactResult(
+        name="figure_work_precision_ch2",
+        table=wp[["problem", "series", "p", "fe_h_inv", "be_h_inv", "dof", "fe_l2", "fe_h1",
+                  "be_l2", "be_h1", "assembly_s", "solve_s", "wall_time_s"]],
+        figure=fig,
+        claims=[Claim("beyond the thesis: for the smooth solution the p-version reaches a "
+                      "given accuracy in less time than the h-version",
+                      bool(best["smooth"] is not None and best["smooth"].series == "p"),
+                      ev)],
+        notes="Beyond the thesis. Wall time = assembly (FE stiffness, S_hat, coupling) + "
+              "static-condensation solve of one run, single process; numba compilation "
+              f"excluded (measured separately: {jit_s:.1f} s). Error = FE + BE energy error.",
+        meta=dict(meta, total_s=round(time.perf_counter() - t_all, 2))))
+    return results

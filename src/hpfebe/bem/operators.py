@@ -1,0 +1,93 @@
+"""What every boundary element operator family shares (Section 1.4).
+
+:class:`BoundaryOperators` owns the spaces W_hp and V_hp of one mesh, caches the matrices
+(assembled on first use), and builds from a subclass's V, K, M, W and its constraint
+functionals C the discrete Steklov-Poincare operator and the discrete traction
+
+    B = K + M/2,     S_hat = W + B^T P B,     Psi = P B U,
+    P = V^{-1} - V^{-1} C (C^T V^{-1} C)^{-1} C^T V^{-1}    (constrained)
+    P = V^{-1}                                               (unconstrained, the thesis),
+
+with V factorised once (Cholesky).  The constraint C^T Psi = 0 is the one the exact
+traction of a solution without sources satisfies (zero flux for Laplace, zero total force
+for Lame); it makes S_hat independent of the kernel's length scale (see
+:mod:`hpfebe.bem.laplace`).  Subclasses (:class:`~hpfebe.bem.laplace.LaplaceBEM`,
+:class:`~hpfebe.bem.lame.LameBEM`) define ``d`` (components), ``V``, ``K``, ``M``, ``W``
+and ``constraints``.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import scipy.linalg as sla
+
+from ..geometry import BoundaryMesh
+from ..spaces import ContinuousSpace, DiscontinuousSpace
+
+
+class BoundaryOperators:
+    d = 1
+
+    def __init__(self, mesh: BoundaryMesh, scale: float, constrained: bool):
+        if not isinstance(mesh, BoundaryMesh):
+            raise ValueError(f"mesh must be a BoundaryMesh, got {type(mesh).__name__}")
+        self.mesh = mesh
+        self.scale = float(scale)
+        if not (math.isfinite(self.scale) and self.scale > 0):
+            raise ValueError(f"scale must be positive, got {scale!r}")
+        self.constrained = bool(constrained)
+        self.W_space = DiscontinuousSpace(mesh)
+        self.V_space = ContinuousSpace(mesh)
+        self._cache: dict[str, object] = {}
+
+    def _get(self, name, build):
+        if name not in self._cache:
+            self._cache[name] = build()
+        return self._cache[name]
+
+    @property
+    def K_adj(self) -> np.ndarray:
+        """Adjoint double layer K' = K^T (Galerkin)."""
+        return self.K.T
+
+    @property
+    def B(self) -> np.ndarray:
+        """K + M/2 (test W_hp, trial V_hp): the right-hand side of V Psi = B U."""
+        return self._get("B", lambda: self.K + 0.5 * self.M.toarray())
+
+    @property
+    def V_cho(self):
+        """Cholesky factor of V (computed once)."""
+        def build():
+            try:
+                return sla.cho_factor(self.V, lower=True)
+            except np.linalg.LinAlgError as exc:
+                raise np.linalg.LinAlgError(
+                    "V is not positive definite: increase the kernel scale "
+                    f"(scale={self.scale})") from exc
+        return self._get("V_cho", build)
+
+    @property
+    def S_hat(self) -> np.ndarray:
+        """Discrete Steklov-Poincare operator W + B^T P B (Section 1.4), symmetric."""
+        def build():
+            c, lower = self.V_cho
+            Y = sla.solve_triangular(c, self.B, lower=lower)
+            S = self.W + Y.T @ Y
+            if self.constrained:
+                Z = sla.solve_triangular(c, self.constraints, lower=lower)
+                YZ = Y.T @ Z
+                S -= YZ @ np.linalg.solve(Z.T @ Z, YZ.T)
+            return 0.5 * (S + S.T)
+        return self._get("S_hat", build)
+
+    def Psi(self, U) -> np.ndarray:
+        """Discrete traction Psi = P (K + M/2) U in W_hp."""
+        psi = sla.cho_solve(self.V_cho, self.B @ np.asarray(U))
+        if self.constrained:
+            C = self.constraints
+            VC = self._get("V_inv_C", lambda: sla.cho_solve(self.V_cho, C))
+            psi = psi - VC @ np.linalg.solve(C.T @ VC, np.tensordot(C.T, psi, axes=1))
+        return psi
