@@ -48,6 +48,9 @@ class PenaltyResult:
     pressure : callable (elem, t) -> p_eps = (1/eps)(U_n - g_h)_+ >= 0 on contact
         elements (t in [-1, 1]); pressure_nodes : (x, p) at the GLL nodes of Gamma_C
     active_history : number of contact elements in (partial) contact per iterate
+    jacobian : only with ``solve_penalty(..., keep_jacobian=True)``: the Newton matrix
+        S_hat + (1/eps) J_c(U) at the returned iterate, restricted to the free dofs
+        (dense; e.g. for its condition number), else None
     """
 
     U: np.ndarray
@@ -60,6 +63,7 @@ class PenaltyResult:
     pressure_nodes: tuple = None
     energy: float = float("nan")
     active_history: list = field(default_factory=list)
+    jacobian: np.ndarray | None = None
 
 
 class _ContactTerm:
@@ -144,7 +148,7 @@ class _ContactTerm:
 
 def solve_penalty(bem, eps: float, gap, load=None, contact_label: str = "C",
                   dirichlet_label: str = "D", S=None, max_iter: int = 50,
-                  tol: float = 1e-10) -> PenaltyResult:
+                  tol: float = 1e-10, keep_jacobian: bool = False) -> PenaltyResult:
     """Penalty contact (3.45)-(3.46) with S_hat, by semismooth Newton.
 
     Parameters
@@ -156,6 +160,8 @@ def solve_penalty(bem, eps: float, gap, load=None, contact_label: str = "C",
     S : S_hat to use (default ``bem.S_hat``; pass it to reuse one matrix for many eps)
     max_iter, tol : Newton limit; stop when max|residual| <= tol * scale, scale =
         max(|L|, |(1/eps) int (-g)_+ v_n|, |S_hat|-row-norm * |U|) (relative).
+    keep_jacobian : return the Newton matrix at the final iterate (free dofs) in
+        ``PenaltyResult.jacobian``
 
     A gap that is never closed (g_h >= 0 on Gamma_C and no load pushing into the obstacle)
     gives the zero-contact solution: zero pressure, reason "no contact" if U = 0 solves.
@@ -245,6 +251,7 @@ def solve_penalty(bem, eps: float, gap, load=None, contact_label: str = "C",
                 break
             seen.setdefault(key, it)
     p_fun, p_nodes = term.pressure(U, eps)
+    jac = (Sff + Jc[np.ix_(free, free)] / eps) if keep_jacobian else None
     return PenaltyResult(U=U, iterations=it, residuals=residuals, converged=converged,
                          reason=reason, eps=eps, pressure=p_fun, pressure_nodes=p_nodes,
-                         energy=float(Jv), active_history=active_hist)
+                         energy=float(Jv), active_history=active_hist, jacobian=jac)
