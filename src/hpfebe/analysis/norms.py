@@ -43,20 +43,25 @@ def boundary_l2_error(space, coeffs, exact, extra: int = 6) -> float:
     return float(np.sqrt(np.sum(ds * diff**2)))
 
 
-def neumann_functional(space: ContinuousSpace, flux, extra: int = 6) -> np.ndarray:
-    """F_j = int_Gamma flux U_j ds for the basis U_j of V_hp (the load of a Neumann
-    problem; flux(x, n))."""
-    mesh = space.mesh
-    F = np.zeros(space.ndof)
+def _degree_groups(mesh, f, extra: int):
+    """Per degree p of the mesh: the elements of that degree, a Gauss rule with p + extra
+    points on [-1, 1], and the values f(x, n) at its points, shape (n_elements, n_points)."""
     for p in np.unique(mesh.degrees):
         p = int(p)
         els = np.flatnonzero(mesh.degrees == p)
         t, w = gauss_legendre(p + extra)
         x = mesh.points(els[:, None], t[None, :]).reshape(-1, 2)
         n = np.repeat(mesh.normals[els], len(t), axis=0)
-        fv = np.asarray(flux(x, n), dtype=float).reshape(len(els), len(t))
-        lj = space._values(p, t)                                    # (nq, p+1)
-        loc = (fv * w) @ lj * (mesh.lengths[els, None] / 2.0)       # (ne_p, p+1)
+        yield p, els, t, w, np.asarray(f(x, n), dtype=float).reshape(len(els), len(t))
+
+
+def neumann_functional(space: ContinuousSpace, flux, extra: int = 6) -> np.ndarray:
+    """F_j = int_Gamma flux U_j ds for the basis U_j of V_hp (the load of a Neumann
+    problem; flux(x, n))."""
+    mesh = space.mesh
+    F = np.zeros(space.ndof)
+    for p, els, t, w, fv in _degree_groups(mesh, flux, extra):
+        loc = (fv * w) @ space._values(p, t) * (mesh.lengths[els, None] / 2.0)  # (ne, p+1)
         d = space.elem_dofs[els, :p + 1]
         np.add.at(F, d[d >= 0], loc[d >= 0])
     return F
@@ -70,15 +75,8 @@ def _richer(op, extra: int):
 
 def _project_W(space: DiscontinuousSpace, f, extra: int = 6) -> np.ndarray:
     """L2 projection of f(x, n) onto W_hp, element by element."""
-    mesh = space.mesh
     c = np.zeros(space.ndof)
-    for p in np.unique(mesh.degrees):
-        p = int(p)
-        els = np.flatnonzero(mesh.degrees == p)
-        t, w = gauss_legendre(p + extra)
-        x = mesh.points(els[:, None], t[None, :]).reshape(-1, 2)
-        n = np.repeat(mesh.normals[els], len(t), axis=0)
-        fv = np.asarray(f(x, n), dtype=float).reshape(len(els), len(t))
+    for p, els, t, w, fv in _degree_groups(space.mesh, f, extra):
         k = np.arange(p)
         c[space.elem_dofs[els, :p]] = (fv * w) @ legendre_values(p, t) * ((2 * k + 1) / 2.0)
     return c
