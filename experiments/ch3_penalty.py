@@ -41,6 +41,7 @@ import time
 import numpy as np
 import pandas as pd
 from matplotlib.figure import Figure
+from matplotlib.ticker import NullFormatter
 
 from hpfebe import BoundaryMesh
 from hpfebe.analysis import aitken, observed_rates
@@ -229,6 +230,7 @@ def run(config: dict, quick: bool = False) -> list[ArtefactResult]:
     e0 = table[table.C_eps == min(C_list)].err.iloc[-1]
     ax.loglog(dref, 1.5 * e0 * dref[-1] / dref, "k--", alpha=0.6, label="slope -1 (h)")
     ax.set_xlabel("DOF")
+    ax.xaxis.set_minor_formatter(NullFormatter())  # overlapping minor-tick labels
     ax.set_ylabel(r"err$(U^\epsilon)$")
     ax.set_title(f"Penalty h-BEM, eps = C_eps h (plane {best})")
     ax.grid(True, which="both", alpha=0.3)
