@@ -64,9 +64,17 @@ and stays fixed).  Globalisation: backtracking line search on the convex energy
     J(U) = 1/2 U.S U - L(U) + int (1/(2 eps_n)) (U_n - g)_+^2 + F Huber(U_t - w - g_t^p)
 
 for Tresca (the equation is its gradient), and on the merit 1/2 |residual|^2 for Coulomb
-(no potential).  Diagnostics: per step iterations, residual history (max-norm over the
-free dofs), converged flag and reason ("converged", "no load", "max_iter",
-"singular Newton matrix ...", "diverged ...", "line search failed", "cycling ...").
+(no potential).  Start of each step (``predictor=True``, the default): the solution of
+the linear "bonded" problem (every Gauss point in contact and sticking, relative to the
+current slip g_t^p) when it has a lower merit than the previous step's U.  Without it,
+the first Newton step from U = 0 sees |t_trial| = |w|/eps_t, i.e. full slip, and for
+stiff penalties (eps ~ 1e-7 h, the thesis's smallest) the semismooth iteration then
+crawls through the stick band of width eps_t s (measured: 25 iterations instead of 1-3
+on the 6 x 4 elements, p = 2 block).  The predictor is counted as an iteration.
+
+Diagnostics: per step iterations, residual history (max-norm over the free dofs),
+converged flag and reason ("converged", "no load", "max_iter", "singular Newton matrix
+...", "diverged ...", "line search failed", "cycling ...").
 """
 
 from __future__ import annotations
@@ -87,14 +95,16 @@ STATE_NAMES = {OPEN: "open", STICK: "stick", SLIP: "slip"}
 
 @dataclass
 class StepInfo:
-    """One load step: load factor, Newton iterations, residual history (max-norm over the
-    free dofs, one entry per iterate including the start), outcome."""
+    """One load step: load factor, iterations (linear solves: the bonded predictor if it
+    was taken, then Newton steps), residual history (max-norm over the free dofs, one
+    entry per iterate including the start), outcome."""
 
     load_factor: float
     iterations: int
     residuals: list
     converged: bool
     reason: str
+    predictor_used: bool = False
 
 
 @dataclass
@@ -110,6 +120,8 @@ class FrictionResult:
         on obstacle; traction on the body is -p_n n - t_t t), bound (s = F or
         mu_f p_n), state (OPEN=0 / STICK=1 / SLIP=2), slip (accumulated g_t^p),
         gap_function (U_n - g) and rel_slip (U_t - w).
+    load_vector, obstacle_motion : the load and obstacle motion w (at the points) of the
+        last step (used by ``initial=`` to continue loading)
     """
 
     U: np.ndarray
@@ -129,6 +141,8 @@ class FrictionResult:
     slip: np.ndarray = None
     gap_function: np.ndarray = None
     rel_slip: np.ndarray = None
+    load_vector: np.ndarray = None
+    obstacle_motion: np.ndarray = None
 
     @property
     def iterations(self) -> list:
@@ -163,6 +177,14 @@ def _positive(name, value, allow_zero=False):
     return v
 
 
+def _count(name, value):
+    """An integer >= 1 (bools and non-integral values rejected)."""
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer, float)) or \
+            not np.isfinite(value) or int(value) != value or int(value) < 1:
+        raise ValueError(f"{name} must be an integer >= 1, got {value!r}")
+    return int(value)
+
+
 def _field(name, value, pts, allow_negative=True):
     """A float or callable x -> values, evaluated at the contact points."""
     if value is None:
@@ -175,7 +197,8 @@ def _field(name, value, pts, allow_negative=True):
         try:
             v = np.full(len(pts), float(value))
         except (TypeError, ValueError):
-            raise ValueError(f"{name} must be a float or a callable, got {value!r}") from None
+            raise ValueError(f"{name} must be a float or a callable, "
+                             f"got {value!r}") from None
     if not np.all(np.isfinite(v)):
         raise ValueError(f"{name} must be finite on Gamma_C")
     if not allow_negative and np.any(v < 0):
@@ -236,7 +259,8 @@ class _FrictionTerm:
 
     def jacobian(self, st):
         Wn = (self.w * st["dpn"])[:, None] * self.Nn
-        Wt = (self.w * st["dtt"])[:, None] * self.Nt + (self.w * st["dtn"])[:, None] * self.Nn
+        Wt = ((self.w * st["dtt"])[:, None] * self.Nt
+              + (self.w * st["dtn"])[:, None] * self.Nn)
         return self.Nn.T @ Wn + self.Nt.T @ Wt
 
     def energy(self, st, eps_n, eps_t, F):
@@ -252,7 +276,8 @@ def solve_friction(bem, eps_n: float, eps_t: float, gap, friction: str = "tresca
                    F=None, mu_f=None, obstacle_slip=None, load=None, load_steps: int = 1,
                    contact_label: str = "C", dirichlet_label: str = "D",
                    max_iter: int = 50, tol: float = 1e-10, S=None,
-                   nq: int | None = None) -> FrictionResult:
+                   nq: int | None = None, initial=None,
+                   predictor: bool = True) -> FrictionResult:
     """Frictional penalty contact of a :class:`LameBEM` body with a rigid obstacle.
 
     Parameters
@@ -271,6 +296,13 @@ def solve_friction(bem, eps_n: float, eps_t: float, gap, friction: str = "tresca
         max(|L_j|, |residual at U = 0|, |S_hat U|) over the free dofs
     S : S_hat to reuse (default ``bem.S_hat``); nq : Gauss points per contact element
         (default p_I + 1)
+    predictor : start each load step from the "bonded" predictor (one linear solve with
+        every point in contact and sticking) when it lowers the merit function (module
+        doc); False: plain Newton from the previous step's U (U = 0 at the start)
+    initial : a FrictionResult of the same body, law and contact points to continue
+        from (non-proportional loading, e.g. unloading): U, the slip g_t^p, the load and
+        the obstacle motion start from its final values and are ramped linearly to
+        ``load`` / ``obstacle_slip`` over the load steps
     """
     eps_n = _positive("eps_n", eps_n)
     eps_t = _positive("eps_t", eps_t)
@@ -284,23 +316,24 @@ def solve_friction(bem, eps_n: float, eps_t: float, gap, friction: str = "tresca
             raise ValueError("mu_f is the Coulomb coefficient; Tresca takes F")
     else:
         if mu_f is None:
-            raise ValueError("mu_f (Coulomb coefficient) is required for friction='coulomb'")
+            raise ValueError("mu_f (Coulomb coefficient) is required for "
+                             "friction='coulomb'")
         if F is not None:
             raise ValueError("F is the Tresca bound; Coulomb takes mu_f")
         mu = _positive("mu_f", mu_f, allow_zero=True)
-    if int(max_iter) < 1 or int(max_iter) != max_iter:
-        raise ValueError(f"max_iter must be an integer >= 1, got {max_iter!r}")
-    if int(load_steps) < 1 or int(load_steps) != load_steps:
-        raise ValueError(f"load_steps must be an integer >= 1, got {load_steps!r}")
+    max_iter = _count("max_iter", max_iter)
+    load_steps = _count("load_steps", load_steps)
     tol = _positive("tol", tol)
-    if nq is not None and (int(nq) < 1 or int(nq) != nq):
-        raise ValueError(f"nq must be an integer >= 1, got {nq!r}")
+    if nq is not None:
+        nq = _count("nq", nq)
     mesh, Vs = bem.mesh, bem.V_space
     celems = np.flatnonzero(mesh.where(contact_label))
     if celems.size == 0:
         raise ValueError(f"contact_label {contact_label!r}: no element carries this label")
-    S = bem.S_hat if S is None else np.asarray(S)
     ndof = 2 * Vs.ndof
+    S = bem.S_hat if S is None else np.asarray(S, dtype=float)
+    if S.shape != (ndof, ndof):
+        raise ValueError(f"S must have shape {(ndof, ndof)}, got {S.shape}")
     f = np.zeros(ndof) if load is None else np.asarray(load, dtype=float)
     if f.shape != (ndof,):
         raise ValueError(f"load must have {ndof} entries, got {f.shape}")
@@ -324,12 +357,24 @@ def solve_friction(bem, eps_n: float, eps_t: float, gap, friction: str = "tresca
 
     U = np.zeros(ndof)
     gp = np.zeros(len(term.w))
+    f0, w0 = np.zeros(ndof), np.zeros(len(term.w))
+    if initial is not None:
+        if not isinstance(initial, FrictionResult) or initial.U.shape != (ndof,) or \
+                initial.points.shape != term.points.shape or \
+                not np.allclose(initial.points, term.points) or initial.friction != law:
+            raise ValueError("initial must be a FrictionResult of the same body, contact "
+                             "points and friction law")
+        if not initial.converged:
+            raise ValueError(f"initial did not converge ({initial.reason}); not a state "
+                             "to continue from")
+        U, gp = initial.U.copy(), initial.slip.copy()
+        f0, w0 = initial.load_vector.copy(), initial.obstacle_motion.copy()
     steps = []
     overall_ok, overall_reason = True, "converged"
-    N = int(load_steps)
+    N = load_steps
     for j in range(1, N + 1):
         lam = j / N
-        fj, wj = lam * f, lam * w_full
+        fj, wj = f0 + lam * (f - f0), w0 + lam * (w_full - w0)
 
         def state_of(V):
             st = term.evaluate(V, law, eps_n, eps_t, g, wj, gp, Fv, mu)
@@ -345,13 +390,35 @@ def solve_friction(bem, eps_n: float, eps_t: float, gap, friction: str = "tresca
         scale = max(np.abs(fj).max(initial=0.0), np.abs(G[free]).max(initial=0.0), 1e-300)
         st, G = state_of(U)
         res = [float(np.abs(G[free]).max())]
-        reason, ok, it = "max_iter", False, 0
+        reason, ok, it, used_pred = "max_iter", False, 0, False
         if res[0] == 0.0 or res[0] <= tol * scale:
-            reason, ok = ("no load" if res[0] == 0.0 and not np.any(U) else "converged"), True
-        else:
+            ok = True
+            reason = "no load" if res[0] == 0.0 and not np.any(U) else "converged"
+        elif predictor:
+            # bonded predictor (one linear solve, counted as an iteration): every point
+            # in contact and sticking; taken as the start when it lowers the merit
+            stb = dict(st, dpn=np.full(len(term.w), 1.0 / eps_n),
+                       dtt=np.full(len(term.w), 1.0 / eps_t), dtn=np.zeros(len(term.w)))
+            Ab = Sff + term.jacobian(stb)[np.ix_(free, free)]
+            rhs = fj + term.Nn.T @ (term.w * g / eps_n) \
+                + term.Nt.T @ (term.w * (wj + gp) / eps_t)
+            try:
+                with warnings.catch_warnings():
+                    warnings.simplefilter("error", sla.LinAlgWarning)
+                    Ub = U.copy()
+                    Ub[free] = sla.solve(Ab, (rhs - S[:, fixed] @ U[fixed])[free])
+                stp, Gp = state_of(Ub)
+                if np.all(np.isfinite(Gp)) and merit(Ub, stp, Gp) < merit(U, st, G):
+                    U, st, G, used_pred, it = Ub, stp, Gp, True, 1
+                    res.append(float(np.abs(G[free]).max()))
+                    if res[-1] <= tol * max(scale, np.abs(Sff @ U[free]).max()):
+                        reason, ok = "converged", True
+            except (np.linalg.LinAlgError, ValueError, sla.LinAlgWarning):
+                pass
+        if not ok:
             seen = {}
             phi = merit(U, st, G)
-            for it in range(1, int(max_iter) + 1):
+            for it in range(1 + used_pred, max_iter + 1):
                 A = Sff + term.jacobian(st)[np.ix_(free, free)]
                 try:
                     with warnings.catch_warnings():
@@ -388,14 +455,16 @@ def solve_friction(bem, eps_n: float, eps_t: float, gap, friction: str = "tresca
                 if r <= tol * max(scale, np.abs(Sff @ U[free]).max()):
                     reason, ok = "converged", True
                     break
+                # cycling: a contact state seen before without progress in the merit
+                # (energy for Tresca, which may decrease while the residual grows)
                 key = st["state"].tobytes() + np.signbit(st["trial"]).tobytes()
-                if key in seen and r >= 0.999 * res[seen[key]]:
-                    reason = (f"cycling: contact state of iterate {seen[key]} repeated at "
-                              f"{it} without residual decrease")
+                if key in seen and phi >= seen[key][1] - 1e-12 * abs(seen[key][1]):
+                    reason = (f"cycling: contact state of iterate {seen[key][0]} repeated "
+                              f"at {it} without decrease of the merit function")
                     break
-                seen.setdefault(key, it)
+                seen.setdefault(key, (it, phi))
         steps.append(StepInfo(load_factor=lam, iterations=it, residuals=res,
-                              converged=ok, reason=reason))
+                              converged=ok, reason=reason, predictor_used=used_pred))
         # return map update of the internal variable (slip) with the converged state
         gp = term.Nt @ U - wj - eps_t * st["t_t"]
         if not ok:
@@ -406,4 +475,5 @@ def solve_friction(bem, eps_n: float, eps_t: float, gap, friction: str = "tresca
         U=U, converged=overall_ok, reason=overall_reason, friction=law, eps_n=eps_n,
         eps_t=eps_t, steps=steps, points=term.points, elements=term.elements,
         weights=term.w, p_n=st["p_n"], t_t=st["t_t"], bound=np.asarray(st["s"], float),
-        state=st["state"], slip=gp, gap_function=st["un"], rel_slip=term.Nt @ U - wj)
+        state=st["state"], slip=gp, gap_function=st["un"], rel_slip=term.Nt @ U - wj,
+        load_vector=fj, obstacle_motion=wj)
