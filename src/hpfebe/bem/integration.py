@@ -199,6 +199,17 @@ def far_block(kernel, logc, haslog, kp, d, aI, bI, nI, aJ, bJ, nJ, s0, s1, g0, g
             top += 2
 
 
+@njit(cache=True, inline="always")
+def _add_point(w, phi, psi, mt, mr, d, Kq, out):
+    """out[k, l] += w phi_k psi_l k(r) for one quadrature point (kernel values in Kq[0])."""
+    for k in range(mt):
+        for l in range(mr):
+            f = w * phi[k] * psi[l]
+            for c1 in range(d):
+                for c2 in range(d):
+                    out[k * d + c1, l * d + c2] += f * Kq[0, c1 * d + c2]
+
+
 @njit(cache=True)
 def coincident_block(kernel, logc, haslog, kp, d, aI, bI, nI, kt, pt, kr, pr,
                      gx, gw, lx, lw, gll_x, gll_b, phi, psi, Kq, rxs, rys, out):
@@ -246,12 +257,7 @@ def coincident_block(kernel, logc, haslog, kp, d, aI, bI, nI, kt, pt, kr, pr,
                     else:
                         for c in range(dd):
                             Kq[0, c] = logc[c]
-                    for k in range(mt):
-                        for l in range(mr):
-                            f = w * phi[k] * psi[l]
-                            for c1 in range(d):
-                                for c2 in range(d):
-                                    out[k * d + c1, l * d + c2] += f * Kq[0, c1 * d + c2]
+                    _add_point(w, phi, psi, mt, mr, d, Kq, out)
             if part == 1 and not haslog:
                 break
 
@@ -360,12 +366,7 @@ def adjacent_block(kernel, logc, haslog, kp, d, aI, bI, nI, aJ, bJ, nJ, vI, vJ,
                     else:
                         for c in range(dd):
                             Kq[0, c] = logc[c]
-                    for k in range(mt):
-                        for l in range(mr):
-                            f = wt * phi[k] * psi[l]
-                            for c1 in range(d):
-                                for c2 in range(d):
-                                    out[k * d + c1, l * d + c2] += f * Kq[0, c1 * d + c2]
+                    _add_point(wt, phi, psi, mt, mr, d, Kq, out)
     # the part of the longer element outside the Duffy square is a far pair
     if LI > LJ * (1.0 + 1e-13):
         s0, s1 = (fI, 1.0) if vI == 0 else (0.0, 1.0 - fI)
