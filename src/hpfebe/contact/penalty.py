@@ -158,8 +158,10 @@ def solve_penalty(bem, eps: float, gap, load=None, contact_label: str = "C",
     gap : float or callable g(x) (x of shape (n, 2)) on Gamma_C, constraint U_n <= g
     load : interleaved vector L(v) on V_hp^2 (tested Neumann data), default 0
     S : S_hat to use (default ``bem.S_hat``; pass it to reuse one matrix for many eps)
-    max_iter, tol : Newton limit; stop when max|residual| <= tol * scale, scale =
-        max(|L|, |(1/eps) int (-g)_+ v_n|, |S_hat|-row-norm * |U|) (relative).
+    max_iter, tol : Newton limit; stop when max|residual| <= tol * (force scale of the
+        current iterate: max of |L|, |S_hat U| and the contact forces |(1/eps) int
+        (U_n - g)_+ v_n|, free dofs).  (Not relative to the initial residual: that grows
+        like 1/eps and would accept wrong active sets for small eps.)
     keep_jacobian : return the Newton matrix at the final iterate (free dofs) in
         ``PenaltyResult.jacobian``
 
@@ -200,18 +202,22 @@ def solve_penalty(bem, eps: float, gap, load=None, contact_label: str = "C",
 
     def energy_grad(U, jac=True):
         ec, Fc, Jc, nact = term.assemble(U, jac)
-        Jv = 0.5 * U @ (S @ U) + ec / eps - f @ U
-        G = S @ U + Fc / eps - f
-        return Jv, G, Jc, nact
+        SU = S @ U
+        Jv = 0.5 * U @ SU + ec / eps - f @ U
+        G = SU + Fc / eps - f
+        # force scale of this iterate for the stopping test
+        fs = max(np.abs(f[free]).max(initial=0.0), np.abs(SU[free]).max(initial=0.0),
+                 np.abs(Fc[free]).max(initial=0.0) / eps, 1e-300)
+        return Jv, G, Jc, nact, fs
 
     U = np.zeros(ndof)
-    Jv, G, Jc, nact = energy_grad(U)
-    scale = max(np.abs(f).max(initial=0.0), np.abs(G[free]).max(initial=0.0), 1e-300)
+    Jv, G, Jc, nact, fs = energy_grad(U)
     residuals = [float(np.abs(G[free]).max())]
+    energies = [float(Jv)]
     active_hist = [nact]
     seen = {}
     reason, converged, it = "max_iter", False, 0
-    if residuals[0] <= tol * scale or residuals[0] == 0.0:
+    if residuals[0] == 0.0 or (nact == 0 and residuals[0] <= tol * fs):
         reason, converged = ("no contact" if nact == 0 else "converged"), True
     else:
         for it in range(1, int(max_iter) + 1):
@@ -221,12 +227,18 @@ def solve_penalty(bem, eps: float, gap, load=None, contact_label: str = "C",
             except (np.linalg.LinAlgError, ValueError):
                 reason = "singular Newton matrix (body not fixed?)"
                 break
+            # for small eps the residual floor is cond(A) * macheps * (contact forces),
+            # above tol: stop when Newton cannot change U any more
+            if np.abs(dU).max() <= 64 * np.finfo(float).eps * np.abs(U[free]).max():
+                reason, converged = ("converged (Newton update at round-off level; the "
+                                     "residual is limited by the conditioning)"), True
+                break
             # backtracking line search on the convex energy J
             step, ok = 1.0, False
             for _ in range(30):
                 Un = U.copy()
                 Un[free] += step * dU
-                Jn, Gn, Jcn, nactn = energy_grad(Un)
+                Jn, Gn, Jcn, nactn, fsn = energy_grad(Un)
                 if Jn <= Jv + 1e-4 * step * (G[free] @ dU) + 1e-14 * abs(Jv):
                     ok = True
                     break
@@ -234,22 +246,25 @@ def solve_penalty(bem, eps: float, gap, load=None, contact_label: str = "C",
             if not ok:
                 reason = "line search failed"
                 break
-            U, Jv, G, Jc, nact = Un, Jn, Gn, Jcn, nactn
+            U, Jv, G, Jc, nact, fs = Un, Jn, Gn, Jcn, nactn, fsn
             res = float(np.abs(G[free]).max())
             residuals.append(res)
+            energies.append(float(Jv))
             active_hist.append(nact)
-            if res <= tol * max(scale, np.abs(S[np.ix_(free, free)] @ U[free]).max()):
+            if res <= tol * fs:
                 reason, converged = "converged", True
                 break
-            # cycling: the same active pattern as an earlier iterate without progress
+            # cycling: an earlier nodal contact pattern returns and the energy (the merit
+            # the line search decreases) has not decreased since: no progress is possible.
+            # (The residual is no measure here: line-search steps may raise it.)
             key = tuple(np.round(np.concatenate(
                 [np.sign(U[2 * d] * n[0] + U[2 * d + 1] * n[1] - gn)
                  for e, p, d, n, idx, gn in term.items]), 0))
-            if key in seen and res >= 0.999 * residuals[seen[key]]:
+            if key in seen and Jv >= energies[seen[key]] - 1e-14 * abs(Jv):
                 reason = (f"cycling: active set of iterate {seen[key]} repeated at {it} "
-                          "without residual decrease")
+                          "without energy decrease")
                 break
-            seen.setdefault(key, it)
+            seen[key] = it
     p_fun, p_nodes = term.pressure(U, eps)
     jac = (Sff + Jc[np.ix_(free, free)] / eps) if keep_jacobian else None
     return PenaltyResult(U=U, iterations=it, residuals=residuals, converged=converged,
