@@ -1,0 +1,25 @@
+"""A posteriori error estimation and adaptive h-refinement (Section 3.3).
+
+* :mod:`.marking` - maximum strategy (Algorithm 3.2), the thesis's "largest share"
+  criterion, Doerfler bulk marking.
+* :mod:`.bem_estimator` - residual BE indicator (3.107), error measure (3.105), Laplace
+  and Lame.
+* :mod:`.fe_estimator` - residual FE indicator (3.100), error measure (3.99), P1/Q1,
+  Poisson and linear elasticity.
+* :mod:`.adaptive` - the loop of Algorithm 3.2.
+"""
+
+from .adaptive import AdaptiveHistory, adapt, default_refine
+from .bem_estimator import (bem_indicators, boundary_residuals, error_measure_B,
+                            error_measure_B_lame, lame_bem_indicators,
+                            lame_boundary_residuals, solve_lame_mixed, solve_laplace_mixed)
+from .fe_estimator import energy_error as fe_energy_error
+from .fe_estimator import energy_error_elasticity as fe_energy_error_elasticity
+from .fe_estimator import fe_indicators, lame_stress
+from .marking import mark_bulk, mark_doerfler, mark_max
+
+__all__ = ["AdaptiveHistory", "adapt", "default_refine", "bem_indicators",
+           "boundary_residuals", "error_measure_B", "solve_laplace_mixed",
+           "error_measure_B_lame", "lame_bem_indicators", "lame_boundary_residuals",
+           "solve_lame_mixed", "fe_energy_error", "fe_energy_error_elasticity",
+           "fe_indicators", "lame_stress", "mark_bulk", "mark_doerfler", "mark_max"]

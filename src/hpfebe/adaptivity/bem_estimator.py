@@ -1,0 +1,288 @@
+"""Residual a posteriori error estimate for the Galerkin BEM (Section 3.3.3).
+
+Laplace (below) and Lame (end of the module, same indicator with vector residuals).
+
+Setting (3.90)/(3.95) without contact: U in V_hp, U = 0 on Gamma_D (the space
+H~^(1/2)(Sigma), Sigma = Gamma minus Gamma_D), <S_hat U, V> = <t_hat, V>_{Gamma_N}, and the
+traction-like functions (3.104)
+
+    psi = V^-1 (K + 1/2) u,    Psi = i_h V_h^-1 i_h^* (K + 1/2) U     (the Galerkin Psi).
+
+Indicator (3.107) per boundary element I (contact part: the same with P_n n + P_t t in
+place of t_hat, pass it as the datum of the label "C"):
+
+    eta_h(I)^2 = h_I || t_hat - S_hat U ||^2_{L2(I cap Gamma_N)}
+               + h_I || d/ds (V Psi - (K + 1/2) U) ||^2_{L2(I)}.
+
+Error measure (3.105) without the penalty terms:
+
+    |||u - U|||_B^2 = ||u - U||^2_{H~1/2(Sigma)} + ||psi - Psi||^2_{H^-1/2(Gamma)},
+
+realised as |u - U|_W^2 + ||psi - Psi||_V^2 (equivalent norms: <W.,.> is elliptic on
+H~^(1/2)(Sigma) when Gamma_D has positive length, <V.,.> on H^-1/2), each on a richer
+space (:mod:`hpfebe.analysis.norms`).
+
+How the functions on Gamma are evaluated (and why).  Both residuals are L2 functions with
+logarithmic singularities at the element ends (where Psi and dU/ds jump), so a Galerkin
+projection onto a richer discrete space would need the pairing <W U, phi> with
+discontinuous phi, which the Maue form does not provide.  Instead they are evaluated
+pointwise at quadrature points *on* Gamma through two exact identities of the 2D Laplace
+operators, which reduce everything to one weakly singular kernel, grad_x G:
+
+    W U           = - d/ds V (dU/ds)                          (Maue, pointwise),
+    d/ds (K + 1/2) U = - (K' - 1/2) (dU/ds)                    (conjugate harmonic),
+
+so that with g[f](x) = PV int grad_x G(x, y) f(y) ds_y  (:mod:`._ongamma`, exact Cauchy
+principal value on the element of x, adaptive Gauss on the others), U' = dU/ds in W_hp:
+
+    S_hat U = W U + (K' + 1/2) Psi      = - g[U'] . t + g[Psi] . n + Psi / 2,
+    d/ds (V Psi - (K + 1/2) U)          =   g[Psi] . t + g[U'] . n - U' / 2.
+
+Both identities are checked to round-off in tests/test_adaptivity.py (Calderon: W u =
+(1/2 - K') psi for an exact harmonic pair).  The L2(I) norms use composite Gauss on a mesh
+of I graded geometrically towards both ends (the log singularities); against a rule with
+8 grading levels and 8 more points per interval the indicators change by < 0.4 %.
+
+Psi is the operator class's Psi(U): with ``zero_flux=True`` (the default of LaplaceBEM)
+it is constrained to zero total flux, so V Psi - (K + 1/2) U is L2-orthogonal to W_hp
+only up to a constant; d/ds removes the constant, so the indicator is unaffected.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import scipy.linalg as sla
+
+from ..analysis.norms import energy_error_dirichlet, energy_error_neumann, neumann_functional
+from ..quadrature import gauss_legendre
+from ._ongamma import grad_single_layer_on_gamma
+
+
+def _call_datum(f, x, n, elem, t):
+    """A prescribed traction f(x, n), or f(x, n, elem, t) when it needs the element and
+    reference coordinate of the points (e.g. the contact traction P_n n + P_t t computed
+    from the discrete solution U at those points)."""
+    import inspect
+
+    try:
+        nparams = len(inspect.signature(f).parameters)
+    except (TypeError, ValueError):
+        nparams = 2
+    return f(x, n, elem, t) if nparams >= 4 else f(x, n)
+
+
+def graded_rule(m: int, levels: int = 3, sigma: float = 0.2):
+    """Composite Gauss rule on [-1, 1] (points, weights), m points per sub-interval, with
+    sub-intervals graded geometrically (ratio ``sigma``, ``levels`` levels) towards both
+    ends."""
+    xg, wg = gauss_legendre(m)
+    d = [sigma ** k for k in range(levels, 0, -1)]  # distances from the end, increasing
+    left = [-1.0] + [-1.0 + 2 * s for s in d]
+    right = [1.0 - 2 * s for s in d[::-1]] + [1.0]
+    br = np.array(left + right)
+    pts, wts = [], []
+    for a, b in zip(br[:-1], br[1:]):
+        pts.append(0.5 * (a + b) + 0.5 * (b - a) * xg)
+        wts.append(0.5 * (b - a) * wg)
+    return np.concatenate(pts), np.concatenate(wts)
+
+
+def solve_laplace_mixed(op, flux, dirichlet=("D",)):
+    """Primal BEM (3.95) without contact: U in V_hp with U = 0 on ``dirichlet`` elements,
+    S_hat U = t_hat weakly on the rest.  ``flux(x, n)`` is the Neumann datum t_hat (its
+    values on Gamma_D are not used).  Returns (U, Psi)."""
+    V = op.V_space
+    fixed = V.dofs_on(*dirichlet)
+    if fixed.size == 0:
+        raise ValueError(f"dirichlet labels {dirichlet!r} select no element: the pure "
+                         "Neumann problem is not handled here")
+    free = np.setdiff1d(np.arange(V.ndof), fixed)
+    F = neumann_functional(V, flux)
+    U = np.zeros(V.ndof)
+    U[free] = sla.solve(op.S_hat[np.ix_(free, free)], F[free], assume_a="pos")
+    return U, op.Psi(U)
+
+
+def boundary_residuals(op, U, Psi, nq: int | None = None):
+    """S_hat U and d/ds (V Psi - (K + 1/2) U) at graded quadrature points of every element.
+
+    Returns dict with elem, t, x, n, w (weights of ds), SU, dres."""
+    mesh = op.mesh
+    W = op.W_space
+    if nq is None:
+        nq = int(mesh.degrees.max()) + 3
+    tq, wq = graded_rule(nq)
+    ne = mesh.n_elements
+    elem = np.repeat(np.arange(ne), len(tq))
+    t = np.tile(tq, ne)
+    dU = op.T @ np.asarray(U, dtype=float)        # W_hp coefficients of dU/ds (exact)
+    gU = grad_single_layer_on_gamma(W, dU, elem, t)
+    gP = grad_single_layer_on_gamma(W, Psi, elem, t)
+    tan, nrm = mesh.tangents[elem], mesh.normals[elem]
+    Psi_x = W.evaluate(Psi, elem, t)
+    dU_x = W.evaluate(dU, elem, t)
+    SU = -np.sum(gU * tan, 1) + np.sum(gP * nrm, 1) + 0.5 * Psi_x
+    dres = np.sum(gP * tan, 1) + np.sum(gU * nrm, 1) - 0.5 * dU_x
+    return dict(elem=elem, t=t, x=mesh.points(elem, t), n=nrm,
+                w=np.tile(wq, ne) * mesh.lengths[elem] / 2.0, SU=SU, dres=dres)
+
+
+def bem_indicators(op, U, Psi, tractions: dict, nq: int | None = None,
+                   return_parts: bool = False):
+    """eta_h(I) of (3.107) per element (not squared).
+
+    ``tractions`` maps a boundary label to the prescribed traction on it, a callable
+    ``f(x, n)`` or ``f(x, n, elem, t)`` (points also given as element index and reference
+    coordinate in (-1, 1)): t_hat on "N", P_n n + P_t t on "C".  Elements with other labels (e.g.
+    Gamma_D) get only the consistency term h_I ||d/ds (V Psi - (K + 1/2) U)||^2."""
+    mesh = op.mesh
+    r = boundary_residuals(op, U, Psi, nq)
+    h = mesh.lengths
+    ne = mesh.n_elements
+    cons = h * np.bincount(r["elem"], r["w"] * r["dres"] ** 2, minlength=ne)
+    trac = np.zeros(ne)
+    for label, f in tractions.items():
+        on = mesh.labels[r["elem"]] == label
+        if not np.any(on):
+            continue
+        data = np.asarray(_call_datum(f, r["x"][on], r["n"][on], r["elem"][on], r["t"][on]),
+                          dtype=float)
+        trac += h * np.bincount(r["elem"][on], r["w"][on] * (data - r["SU"][on]) ** 2,
+                                minlength=ne)
+    eta = np.sqrt(cons + trac)
+    if return_parts:
+        return eta, {"traction": np.sqrt(trac), "consistency": np.sqrt(cons)}
+    return eta
+
+
+def error_measure_B(op, U, Psi, u_exact, flux_exact, extra: int = 3) -> float:
+    """|||u - U|||_B of (3.105) without contact terms: (|u - U|_W^2 + ||psi - Psi||_V^2)^(1/2)
+    with exact trace ``u_exact(x, n)`` and exact Neumann datum ``flux_exact(x, n)``."""
+    eu = energy_error_dirichlet(op, U, u_exact, extra=extra)
+    ep = energy_error_neumann(op, Psi, flux_exact, extra=extra)
+    return float(np.hypot(eu, ep))
+
+
+# ----------------------------------------------------------------------------- Lame
+# For Lame the identities above become longer (Guenter derivatives); instead both
+# functions are taken as one-sided limits of the discrete representation
+#     w = SL Psi - DL U   (Somigliana, :meth:`LameBEM.displacement_gradient`),
+# whose interior traces are, by the jump relations (V t = (K + 1/2) u convention),
+#     gamma_0 w = V Psi - (K - 1/2) U = (V Psi - (K + 1/2) U) + U,
+#     T w       = (K' + 1/2) Psi + W U = S_hat U,
+# so that  d/ds (V Psi - (K + 1/2) U) = grad w . t - dU/ds  and  S_hat U = sigma(w) n,
+# evaluated at x - delta h_I n.  delta = 1e-5: the limit error is O(delta log delta) at the
+# graded quadrature points (>= 4e-4 h_I from the element ends), while the near-boundary
+# quadrature of the potentials loses accuracy below ~1e-6 (measured on a linear field:
+# 1e-9 at 1e-4, 6e-6 at 1e-6, 0.2 at 1e-8; on a Kelvin field the result is stable for
+# delta in [1e-6, 1e-4]).
+
+
+def lame_boundary_residuals(op, U, Psi, nq: int | None = None, delta: float = 1e-5):
+    """Lame analogue of :func:`boundary_residuals`: SU (n, 2) and dres (n, 2)."""
+    mesh = op.mesh
+    if nq is None:
+        nq = int(mesh.degrees.max()) + 3
+    tq, wq = graded_rule(nq)
+    ne = mesh.n_elements
+    elem = np.repeat(np.arange(ne), len(tq))
+    t = np.tile(tq, ne)
+    tan, nrm = mesh.tangents[elem], mesh.normals[elem]
+    x = mesh.points(elem, t)
+    xin = x - delta * mesh.lengths[elem, None] * nrm
+    G = op.displacement_gradient(xin, U, Psi)                 # (n, i, m) = du_i/dx_m
+    div = G[:, 0, 0] + G[:, 1, 1]
+    S = op.lam * div[:, None, None] * np.eye(2) + op.mu * (G + np.swapaxes(G, 1, 2))
+    dU = (op.T @ np.asarray(U, dtype=float)).reshape(-1, 2)
+    dU_x = op.W_space.evaluate(dU, elem, t)                   # (n, 2)
+    SU = np.einsum("qij,qj->qi", S, nrm)
+    dres = np.einsum("qim,qm->qi", G, tan) - dU_x
+    return dict(elem=elem, t=t, x=x, n=nrm, w=np.tile(wq, ne) * mesh.lengths[elem] / 2.0,
+                SU=SU, dres=dres)
+
+
+def _lame_dofs(scalar_dofs):
+    d = np.asarray(scalar_dofs)
+    return np.column_stack([2 * d, 2 * d + 1]).ravel()
+
+
+def solve_lame_mixed(op, traction, dirichlet=("D",), u_dirichlet=None):
+    """Primal Lame BEM: U in V_hp^2 with U = I_h u_dirichlet (default 0) on the
+    ``dirichlet`` elements, S_hat U = t_hat weakly on the rest; ``traction(x, n)`` returns
+    (n, 2).  Returns (U, Psi), interleaved."""
+    Vs = op.V_space
+    fixed = _lame_dofs(Vs.dofs_on(*dirichlet))
+    if fixed.size == 0:
+        raise ValueError(f"dirichlet labels {dirichlet!r} select no element")
+    free = np.setdiff1d(np.arange(2 * Vs.ndof), fixed)
+    F = np.column_stack([neumann_functional(Vs, lambda x, n, c=c: traction(x, n)[:, c])
+                         for c in range(2)]).ravel()
+    U = np.zeros(2 * Vs.ndof)
+    if u_dirichlet is not None:
+        g = np.column_stack([Vs.interpolate(lambda x, c=c: u_dirichlet(x)[:, c])
+                             for c in range(2)]).ravel()
+        U[fixed] = g[fixed]
+    S = op.S_hat
+    rhs = F[free] - S[np.ix_(free, fixed)] @ U[fixed]
+    U[free] = sla.solve(S[np.ix_(free, free)], rhs, assume_a="pos")
+    return U, op.Psi(U)
+
+
+def lame_bem_indicators(op, U, Psi, tractions: dict, nq: int | None = None,
+                        return_parts: bool = False, delta: float = 1e-5):
+    """eta_h(I) of (3.107) for Lame (vector residuals, Euclidean norm); ``tractions`` maps
+    labels to callables (x, n) -> (n, 2) or (x, n, elem, t) -> (n, 2) (t_hat on "N",
+    P_n n + P_t t on "C", see :func:`bem_indicators`)."""
+    mesh = op.mesh
+    r = lame_boundary_residuals(op, U, Psi, nq, delta)
+    h = mesh.lengths
+    ne = mesh.n_elements
+    cons = h * np.bincount(r["elem"], r["w"] * np.sum(r["dres"] ** 2, 1), minlength=ne)
+    trac = np.zeros(ne)
+    for label, f in tractions.items():
+        on = mesh.labels[r["elem"]] == label
+        if not np.any(on):
+            continue
+        data = np.asarray(_call_datum(f, r["x"][on], r["n"][on], r["elem"][on], r["t"][on]),
+                          dtype=float).reshape(-1, 2)
+        trac += h * np.bincount(r["elem"][on],
+                                r["w"][on] * np.sum((data - r["SU"][on]) ** 2, 1),
+                                minlength=ne)
+    eta = np.sqrt(cons + trac)
+    if return_parts:
+        return eta, {"traction": np.sqrt(trac), "consistency": np.sqrt(cons)}
+    return eta
+
+
+def error_measure_B_lame(op, U, Psi, u_exact, traction_exact, extra: int = 3) -> float:
+    """|||u - U|||_B (3.105) for Lame: (<W e_u, e_u> + <V e_psi, e_psi>)^(1/2) on the
+    space of degree p_I + ``extra`` (exact u interpolated, exact traction projected per
+    component; the discrete U, Psi embed exactly)."""
+    from ..analysis.norms import _project_W
+    from ..bem.lame import LameBEM
+    from ..quadrature import gauss_lobatto
+
+    hi = LameBEM(op.mesh.with_degrees(op.mesh.degrees + extra), op.E, op.nu, op.plane,
+                 scale=op.scale, zero_force=op.zero_force)
+    # traction
+    ep = np.column_stack([_project_W(hi.W_space, lambda x, n, c=c: traction_exact(x, n)[:, c])
+                          for c in range(2)])
+    lo_d, hi_d = op.W_space.elem_dofs, hi.W_space.elem_dofs
+    mask = lo_d >= 0
+    ep[hi_d[:, :lo_d.shape[1]][mask]] -= np.asarray(Psi).reshape(-1, 2)[lo_d[mask]]
+    ep = ep.ravel()
+    # displacement
+    eu = np.zeros((hi.V_space.ndof, 2))
+    mesh = hi.mesh
+    Ul = np.asarray(U).reshape(-1, 2)
+    for p in np.unique(mesh.degrees):
+        p = int(p)
+        els = np.flatnonzero(mesh.degrees == p)
+        xl, _ = gauss_lobatto(p + 1)
+        elem = np.repeat(els, p + 1)
+        t = np.tile(xl, len(els))
+        vals = np.asarray(u_exact(mesh.points(elem, t)), dtype=float) \
+            - op.V_space.evaluate(Ul, elem, t)
+        eu[hi.V_space.elem_dofs[els, :p + 1].ravel()] = vals
+    eu = eu.ravel()
+    return float(np.sqrt(max(eu @ hi.W @ eu, 0.0) + max(ep @ hi.V @ ep, 0.0)))
