@@ -31,7 +31,9 @@ Rules
 * ``run`` returns one :class:`hpfebe.results.ArtefactResult` per entry of
   ``ARTEFACTS`` (no more, no fewer).  It does not write files: ``hpfebe run`` validates
   all results first and then writes them (:func:`hpfebe.results.write_result`), so a
-  contract breach never leaves half a set.
+  contract breach never leaves half a set.  Meshes and fields for ParaView go into
+  ``ArtefactResult.exports`` ({key: meshio.Mesh}, built with :mod:`hpfebe.export`) and
+  are written as ``results/<id>_<key>.vtu``.
 * ``table``: the published columns first, with the same names as in
   ``report/published/<published>``, then what else was measured (``dof``,
   ``wall_time_s``, iterations ...).  ``keys`` are the columns joining it with the

@@ -170,6 +170,18 @@ def estimate(state, prm, gap, eps, weight=1.0):
     return np.sqrt(parts["traction"] ** 2 + (weight * parts["consistency"]) ** 2)
 
 
+def final_vtu(recs):
+    """meshio mesh of the last adaptive boundary mesh with U (V_hp^2) and the indicator."""
+    from hpfebe.export import boundary_vtu
+
+    st = recs[-1]["state"]
+    op = st["op"]
+    mesh = boundary_vtu(op.mesh, op.V_space, {"displacement": st["U"]}, d=2)
+    elem = mesh.cell_data["element"][0]
+    mesh.cell_data["eta"] = [np.asarray(recs[-1]["eta"], dtype=float)[elem]]
+    return mesh
+
+
 def adaptive_run(example, d, prm, eps, n_steps, marking="max", weight=1.0):
     """Algorithm 3.2 with n_steps refinements (n_steps + 1 solves).  Returns a list of
     per-mesh records: mesh, state, eta, marked (mask of refined elements)."""
@@ -867,7 +879,7 @@ def run(config: dict, quick: bool = False) -> list[ArtefactResult]:
                        figure=fig_mesh_sequence(recs1, mag, f"Fig. 3.4 (d = {d_main:g}, "
                                                 f"{primary} indicator)"),
                        claims=refine_claims + [sym_claim, newton_claim], notes=notes,
-                       meta=nonan),
+                       meta=nonan, exports={"final_mesh": final_vtu(recs1)}),
         ArtefactResult(name="figure_3_5", table=ranges[ranges.example == 1]
                        .reset_index(drop=True),
                        figure=fig_interior(X, Y, u1, mag, f"Fig. 3.5: Example 1, d = "
@@ -886,7 +898,8 @@ def run(config: dict, quick: bool = False) -> list[ArtefactResult]:
         ArtefactResult(name="figure_3_8", table=steps2,
                        figure=fig_mesh_sequence(recs2, mag, f"Fig. 3.8 (d = {d2:g}, "
                                                 f"{primary} indicator)"),
-                       claims=ex2_claims + [newton_claim], notes=notes, meta=nonan),
+                       claims=ex2_claims + [newton_claim], notes=notes, meta=nonan,
+                       exports={"final_mesh": final_vtu(recs2)}),
         ArtefactResult(name="figure_3_9", table=ranges[ranges.example == 2]
                        .reset_index(drop=True),
                        figure=fig_interior(X2, Y2, u2, mag, f"Fig. 3.9: Example 2, d = "

@@ -21,11 +21,9 @@ thesis is followed):
 * figure_4_14 - indicator (3.100) in Omega_s, uniform vs adaptive refinement, vs DOF;
 * figure_4_15 - the same in Omega_m;
 * figure_4_16 - x- and y-components of the displacement after the last refinement step.
-The last meshes and fields (adaptive and uniform) are also written as VTU files for
-ParaView: to ``config["vtu_dir"]`` (the experiment contract gives a module no output
-folder, ``hpfebe run --out`` is not passed on; default ``results/vtu`` relative to the
-current working directory - next to the results and git-ignored when run from the
-repository root; null = no VTU).
+The last meshes and fields (adaptive and uniform) are also returned as VTU exports of
+figure_4_16 (``results/figure_4_16_<adaptive|uniform>_final_<slave|master>.vtu``, for
+ParaView).
 
 Choices where the thesis is silent (repeated in the results' notes):
 * initial meshes: uniform triangulations with h = 1/4 (slave 4 x 8 cells, master 16 x 8
@@ -82,7 +80,6 @@ from __future__ import annotations
 import logging
 import math
 import time
-from pathlib import Path
 
 import numpy as np
 import pandas as pd
@@ -107,7 +104,6 @@ DEFAULTS = dict(
     n_refinements=42, theta=0.9, load_steps=5, load_retries=2, rtol=1e-10, max_newton=30,
     max_uniform_steps=5, min_uniform_steps=2, mesh_steps=[0, 5, 10, 21, 36, 42],
     feature_radius=0.25, concentration_share=0.5, enrichment=2.0, feature_h_ratio=0.125,
-    vtu_dir="results/vtu",
 )
 QUICK = dict(n_refinements=4, max_uniform_steps=3, mesh_steps=[0, 1, 2, 4])
 
@@ -334,21 +330,20 @@ def rate(dof, eta, n=3):
 
 
 # --------------------------------------------------------------------------- output
-def write_vtu(folder, tag, pr, res, eta_s, eta_m):
-    from hpfebe.export import write_fe_vtu
+def vtu_meshes(tag, pr, res, eta_s, eta_m) -> dict:
+    """{f"{tag}_{body}": meshio.Mesh} of both bodies with the displacement and the
+    indicator (max over the elements at each vertex), for ArtefactResult.exports."""
+    from hpfebe.export import fe_vtu
 
-    folder = Path(folder)
-    paths = []
-    for body, u, eta in ((pr.slave, res.u_slave, eta_s), (pr.master, res.u_master, eta_m)):
-        name = "slave" if body is pr.slave else "master"
-        un = body.nodal_displacement(u).T
-        # element indicator as a point field: max over the elements at each vertex
+    out = {}
+    for name, body, u, eta in (("slave", pr.slave, res.u_slave, eta_s),
+                               ("master", pr.master, res.u_master, eta_m)):
         ev = np.zeros(body.mesh.p.shape[1])
         for i in range(3):
             np.maximum.at(ev, body.mesh.t[i], eta)
-        paths.append(write_fe_vtu(folder / f"ch4_adaptive_fefe_{tag}_{name}.vtu", body.mesh,
-                                  {"displacement": un, "eta_max_adjacent": ev}))
-    return paths
+        out[f"{tag}_{name}"] = fe_vtu(body.mesh, {"displacement": body.nodal_displacement(u).T,
+                                                  "eta_max_adjacent": ev})
+    return out
 
 
 def _plot_meshes(meshes, steps):
@@ -424,12 +419,10 @@ def run(config: dict, quick: bool = False) -> list[ArtefactResult]:
     t_un = time.perf_counter() - t1
     run_s = time.perf_counter() - t_start
 
-    vtu_paths = []
-    if c.get("vtu_dir"):
-        vtu_paths += write_vtu(c["vtu_dir"], "adaptive_final", *ad_last)
-        vtu_paths += write_vtu(c["vtu_dir"], "uniform_final", *un_last)
-    vtu_note = (f" VTU files (final adaptive and uniform meshes, displacement, indicator): "
-                f"{', '.join(str(p) for p in vtu_paths)}." if vtu_paths else "")
+    exports = {**vtu_meshes("adaptive_final", *ad_last),
+               **vtu_meshes("uniform_final", *un_last)}
+    vtu_note = (" VTU files for ParaView (final adaptive and uniform meshes, displacement, "
+                "indicator): figure_4_16_<adaptive|uniform>_final_<slave|master>.vtu.")
 
     all_conv = bool(ad["newton_converged"].all() and un["newton_converged"].all())
     common_notes = (
@@ -449,8 +442,7 @@ def run(config: dict, quick: bool = False) -> list[ArtefactResult]:
     meta_common = dict(run_s=run_s, adaptive_s=t_ad, uniform_s=t_un,
                        n_refinements=n_ad, newton_all_converged=all_conv,
                        final_dof_slave=int(ad["dof_slave"].iloc[-1]),
-                       final_dof_master=int(ad["dof_master"].iloc[-1]),
-                       vtu=[str(p) for p in vtu_paths])
+                       final_dof_master=int(ad["dof_master"].iloc[-1]))
 
     # ---- figure 4.13: meshes and concentration claim
     steps = [k for k in c["mesh_steps"] if k < len(ad_meshes)]
@@ -575,5 +567,5 @@ def run(config: dict, quick: bool = False) -> list[ArtefactResult]:
                       f"{pen:.3e}; final contact states: {int(res.steps[-1].n_stick)} stick, "
                       f"{int(res.steps[-1].n_slip)} slip, {int(res.steps[-1].n_open)} open")],
         notes=common_notes + f" Fields after adaptive refinement step {n_ad}." + vtu_note,
-        meta=dict(meta_common, max_penetration=pen))
+        meta=dict(meta_common, max_penetration=pen), exports=exports)
     return [res13, decay[0], decay[1], res16]

@@ -5,27 +5,30 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
+import meshio
 import numpy as np
 import pytest
 import yaml
 
 from experiments import ch4_adaptive_fefe as mod
-from hpfebe.results import validate
+from hpfebe.results import validate, write_result
 
 ROOT = Path(__file__).resolve().parents[1]
 
 
-def _quick_config(tmp):
+def _quick_config():
     full = yaml.safe_load((ROOT / "config" / "config.yaml").read_text())["ch4_adaptive_fefe"]
     quick = yaml.safe_load((ROOT / "config" / "quick.yaml").read_text())["ch4_adaptive_fefe"]
-    cfg = {**full, **quick, "vtu_dir": str(tmp)}
-    return cfg
+    return {**full, **quick}
 
 
 @pytest.fixture(scope="module")
 def quick_run(tmp_path_factory):
-    tmp = tmp_path_factory.mktemp("vtu")
-    return mod.run(_quick_config(tmp), quick=True), tmp
+    tmp = tmp_path_factory.mktemp("results")
+    results = mod.run(_quick_config(), quick=True)
+    for r in results:
+        write_result(r, tmp)
+    return results, tmp
 
 
 def test_quick_run_produces_all_artefacts(quick_run):
@@ -37,7 +40,9 @@ def test_quick_run_produces_all_artefacts(quick_run):
         assert r.claims and all(c.holds is not None for c in r.claims), r.name
         assert r.meta["run_s"] < 20
     vtus = sorted(p.name for p in tmp.glob("*.vtu"))
-    assert len(vtus) == 4 and all("ch4_adaptive_fefe" in v for v in vtus)
+    assert len(vtus) == 4 and all(v.startswith("figure_4_16_") for v in vtus), vtus
+    mesh = meshio.read(tmp / vtus[0])
+    assert np.all(np.isfinite(mesh.point_data["displacement"]))
 
 
 def test_adaptive_indicator_below_uniform_at_comparable_dof(quick_run):

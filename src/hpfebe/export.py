@@ -1,10 +1,13 @@
 """VTU export of meshes and fields (for ParaView), written atomically.
 
-* :func:`write_boundary_vtu` - a :class:`~hpfebe.geometry.BoundaryMesh` as a polyline: each
+* :func:`boundary_vtu` - a :class:`~hpfebe.geometry.BoundaryMesh` as a polyline: each
   element of degree p is sampled at its p+1 Gauss-Lobatto points (so higher-order fields
   are shown at their nodes), with point data such as a displacement U in V_hp^d.
-* :func:`write_fe_vtu` - a scikit-fem mesh with nodal point data (P1/Q1 fields, or the
-  vertex values of higher-order ones).
+* :func:`fe_vtu` - a scikit-fem mesh with nodal point data (P1/Q1 fields, or the vertex
+  values of higher-order ones).
+* :func:`write_vtu` writes such a ``meshio.Mesh``; experiments return them in
+  ``ArtefactResult.exports`` and :func:`hpfebe.results.write_result` writes them next to
+  the other result files (``<out>/<artefact>_<key>.vtu``).
 
 Like every file of the suite, the VTU is written to a temporary name in the target folder
 and renamed, so an interrupted run never leaves a half file.
@@ -23,7 +26,8 @@ from .geometry import BoundaryMesh
 from .quadrature import gauss_lobatto
 
 
-def _atomic_meshio_write(path: Path, mesh: meshio.Mesh) -> Path:
+def write_vtu(path, mesh: meshio.Mesh) -> Path:
+    """Write a meshio mesh as VTU, atomically (temporary name, then rename)."""
     path = Path(path)
     if path.suffix != ".vtu":
         raise ValueError(f"path must end in .vtu, got {str(path)!r}")
@@ -39,9 +43,9 @@ def _atomic_meshio_write(path: Path, mesh: meshio.Mesh) -> Path:
     return path
 
 
-def write_boundary_vtu(path, mesh: BoundaryMesh, space=None, fields: dict | None = None,
-                       d: int = 1) -> Path:
-    """Write the boundary mesh, sampled at the Gauss-Lobatto points of every element, with
+def boundary_vtu(mesh: BoundaryMesh, space=None, fields: dict | None = None,
+                 d: int = 1) -> meshio.Mesh:
+    """The boundary mesh, sampled at the Gauss-Lobatto points of every element, with
     ``fields`` = {name: coefficients in ``space`` (V_hp or W_hp), d components
     interleaved}.  Cells are line segments between consecutive samples; cell data
     ``element`` and ``degree`` give the parent element and its p_I."""
@@ -71,14 +75,13 @@ def write_boundary_vtu(path, mesh: BoundaryMesh, space=None, fields: dict | None
         if d == 2:
             vals = np.column_stack([vals, np.zeros(len(vals))])  # VTK vectors are 3D
         point_data[name] = vals.reshape(len(pts), -1).squeeze()
-    out = meshio.Mesh(np.column_stack([pts, np.zeros(len(pts))]), [("line", cells)],
-                      point_data=point_data,
-                      cell_data={"element": [cell_elem], "degree": [mesh.degrees[cell_elem]]})
-    return _atomic_meshio_write(path, out)
+    return meshio.Mesh(np.column_stack([pts, np.zeros(len(pts))]), [("line", cells)],
+                       point_data=point_data,
+                       cell_data={"element": [cell_elem], "degree": [mesh.degrees[cell_elem]]})
 
 
-def write_fe_vtu(path, mesh, point_data: dict | None = None) -> Path:
-    """Write a scikit-fem MeshTri / MeshQuad with nodal ``point_data`` ({name: array of
+def fe_vtu(mesh, point_data: dict | None = None) -> meshio.Mesh:
+    """A scikit-fem MeshTri / MeshQuad with nodal ``point_data`` ({name: array of
     shape (n_vertices,) or (n_vertices, 2)}; 2-vectors are padded to 3D for VTK)."""
     kinds = {3: "triangle", 4: "quad"}
     nverts = mesh.t.shape[0]
@@ -97,5 +100,15 @@ def write_fe_vtu(path, mesh, point_data: dict | None = None) -> Path:
             v = np.column_stack([v, np.zeros(len(v))])
         data[name] = v
     pts = np.column_stack([mesh.p.T, np.zeros(mesh.p.shape[1])])
-    return _atomic_meshio_write(path, meshio.Mesh(pts, [(kinds[nverts], mesh.t.T)],
-                                                  point_data=data))
+    return meshio.Mesh(pts, [(kinds[nverts], mesh.t.T)], point_data=data)
+
+
+def write_boundary_vtu(path, mesh: BoundaryMesh, space=None, fields: dict | None = None,
+                       d: int = 1) -> Path:
+    """:func:`boundary_vtu` written to ``path``."""
+    return write_vtu(path, boundary_vtu(mesh, space, fields, d))
+
+
+def write_fe_vtu(path, mesh, point_data: dict | None = None) -> Path:
+    """:func:`fe_vtu` written to ``path``."""
+    return write_vtu(path, fe_vtu(mesh, point_data))

@@ -81,6 +81,8 @@ class ArtefactResult:
     notes : choices and explanations shown in the report
     meta : timings (jit_s, run_s), dof, iterations, ...; ``allow_nan_columns`` lists
         float columns that may contain NaN (e.g. the first rate of a sweep)
+    exports : {key: meshio.Mesh} meshes with fields for ParaView, written as
+        ``<out>/<name>_<key>.vtu`` (see :mod:`hpfebe.export`)
     """
 
     name: str
@@ -92,6 +94,7 @@ class ArtefactResult:
     claims: list[Claim] = field(default_factory=list)
     notes: str = ""
     meta: dict = field(default_factory=dict)
+    exports: dict[str, Any] = field(default_factory=dict)
 
 
 # --------------------------------------------------------------------------- progress
@@ -311,6 +314,16 @@ def write_result(result: ArtefactResult, out_dir: Path | str, config: dict | Non
     elif png.exists():  # a stale figure from an earlier run would be mistaken as current
         png.unlink()
 
+    exports = []
+    if result.exports:
+        from .export import write_vtu
+
+        for key, mesh in result.exports.items():
+            if not str(key).isidentifier():
+                raise ValueError(f"exports key {key!r} must be an identifier (file name part)")
+            written.append(write_vtu(out / f"{result.name}_{key}.vtu", mesh))
+            exports.append(written[-1].name)
+
     doc = {
         "name": result.name,
         "kind": artefact_kind(result.name),
@@ -324,6 +337,7 @@ def write_result(result: ArtefactResult, out_dir: Path | str, config: dict | Non
         "columns": list(table.columns),
         "n_rows": int(len(table)),
         "has_figure": result.figure is not None,
+        "exports": exports,
         "provenance": provenance(config, run_info),
     }
     text = json.dumps(_jsonable(doc), indent=2, allow_nan=False) + "\n"
