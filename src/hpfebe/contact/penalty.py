@@ -261,8 +261,13 @@ def solve_penalty(bem, eps: float, gap, load=None, contact_label: str = "C",
                 [np.sign(U[2 * d] * n[0] + U[2 * d + 1] * n[1] - gn)
                  for e, p, d, n, idx, gn in term.items]), 0))
             if key in seen and Jv >= energies[seen[key]] - 1e-14 * abs(Jv):
-                reason = (f"cycling: active set of iterate {seen[key]} repeated at {it} "
-                          "without energy decrease")
+                if step * np.abs(dU).max() <= 1e-8 * np.abs(U[free]).max():
+                    # tiny steps, no energy decrease: stagnation at round-off, not cycling
+                    reason, converged = ("converged (stagnation at round-off level; the "
+                                         "residual is limited by the conditioning)"), True
+                else:
+                    reason = (f"cycling: active set of iterate {seen[key]} repeated at {it} "
+                              "without energy decrease")
                 break
             seen[key] = it
     p_fun, p_nodes = term.pressure(U, eps)
