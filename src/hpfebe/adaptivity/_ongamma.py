@@ -28,7 +28,7 @@ import math
 import numpy as np
 from numba import njit, prange
 
-from ..bem.integration import NMAX, _order
+from ..bem.integration import NMAX, _order, point_panels
 from ..quadrature import rule_tables
 from ..spaces import LEGENDRE, P_MAX, eval_basis, gll_tables
 
@@ -44,7 +44,8 @@ def _grad_sl_on_gamma(qe, qt, nodes, elements, degrees, dofs, coef, gx, gw, gll_
     pmax = degrees.max() + 1
     for q in prange(npts):
         phi = np.empty(pmax)
-        stack = np.empty((64, 2))
+        stack = np.empty((128, 2))
+        panels = np.empty((128, 3))
         e0 = qe[q]
         a = nodes[elements[e0, 0]]
         b = nodes[elements[e0, 1]]
@@ -83,21 +84,11 @@ def _grad_sl_on_gamma(qe, qt, nodes, elements, degrees, dofs, coef, gx, gw, gll_
             vx, vy = b[0] - a[0], b[1] - a[1]
             L = math.hypot(vx, vy)
             p = degrees[e]
-            stack[0, 0], stack[0, 1] = 0.0, 1.0
-            top = 1
-            while top > 0:
-                top -= 1
-                s0, s1 = stack[top, 0], stack[top, 1]
+            # x lies on element e0, never on another one: no on-element test (tol_on < 0)
+            npan = point_panels(x0, x1, a, b, -1.0, stack, panels)
+            for ip in range(npan):
+                s0, s1, dist = panels[ip, 0], panels[ip, 1], panels[ip, 2]
                 h = (s1 - s0) * L
-                tt = ((x0 - a[0]) * vx + (x1 - a[1]) * vy) / (L * L)
-                tt = min(s1, max(s0, tt))
-                dist = math.hypot(x0 - a[0] - tt * vx, x1 - a[1] - tt * vy)
-                if dist < h and top < 60 and dist > 1e-14 * L:
-                    m = 0.5 * (s0 + s1)
-                    stack[top, 0], stack[top, 1] = s0, m
-                    stack[top + 1, 0], stack[top + 1, 1] = m, s1
-                    top += 2
-                    continue
                 n = _order(2.0 * dist / h, p + 1, nmax)
                 for k in range(n):
                     ss = s0 + (s1 - s0) * gx[n, k]

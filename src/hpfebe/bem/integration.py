@@ -55,6 +55,38 @@ def _order(ratio, deg, nmax):
 
 
 @njit(cache=True)
+def point_panels(x0, x1, a, b, tol_on, stack, panels):
+    """Panels [s0, s1] of the element [a, b] (parameter s in [0, 1]) for integrating a
+    kernel singular at the point x: bisected until each panel is at least its own
+    length away from x (60 levels at most), so that Gauss of order _order(2 dist / h)
+    is accurate on each.  panels[k] = (s0, s1, dist); returns their number, or -1 if x
+    lies on the element (distance <= tol_on |I|).  ``stack``, ``panels``: (>= 128, .)."""
+    ux, uy = b[0] - a[0], b[1] - a[1]
+    L = math.hypot(ux, uy)
+    stack[0, 0], stack[0, 1] = 0.0, 1.0
+    top = 1
+    npan = 0
+    while top > 0:
+        top -= 1
+        s0, s1 = stack[top, 0], stack[top, 1]
+        h = (s1 - s0) * L
+        t = ((x0 - a[0]) * ux + (x1 - a[1]) * uy) / (L * L)
+        t = min(s1, max(s0, t))
+        dist = math.hypot(x0 - a[0] - t * ux, x1 - a[1] - t * uy)
+        if dist <= tol_on * L:
+            return -1
+        if dist < h and top < 60 and h > 1e-14 * L:
+            m = 0.5 * (s0 + s1)
+            stack[top, 0], stack[top, 1] = s0, m
+            stack[top + 1, 0], stack[top + 1, 1] = m, s1
+            top += 2
+            continue
+        panels[npan, 0], panels[npan, 1], panels[npan, 2] = s0, s1, dist
+        npan += 1
+    return npan
+
+
+@njit(cache=True)
 def _seg_dist(ax, ay, bx, by, cx, cy, dx, dy):
     """Distance between the segments [a, b] and [c, d] (assumed not crossing)."""
     best = 1e300

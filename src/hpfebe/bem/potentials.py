@@ -20,7 +20,7 @@ from numba import njit, prange
 
 from ..quadrature import rule_tables
 from ..spaces import P_MAX, eval_basis, gll_tables, n_local
-from .integration import NMAX, _order
+from .integration import NMAX, _order, point_panels
 from .kernels import INV_2PI, _log_rr, _traction_of_G
 
 # potential kernel ids; kp is the parameter array of the owning operator class
@@ -118,7 +118,8 @@ def _potential(kid, kp, d, nout, pts, nodes, elements, normals, degrees, kind, d
         phi = np.empty(pmax)
         kv = np.empty(nout * d)
         fv = np.empty(d)
-        stack = np.empty((64, 2))
+        stack = np.empty((128, 2))
+        panels = np.empty((128, 3))
         x0, x1 = pts[q, 0], pts[q, 1]
         acc = np.zeros(nout)
         onb = False
@@ -130,24 +131,13 @@ def _potential(kid, kp, d, nout, pts, nodes, elements, normals, degrees, kind, d
             p = degrees[e]
             nl = n_local(kind, p)
             deg = p - 1 if kind == 0 else p
-            stack[0, 0], stack[0, 1] = 0.0, 1.0
-            top = 1
-            while top > 0:
-                top -= 1
-                s0, s1 = stack[top, 0], stack[top, 1]
+            npan = point_panels(x0, x1, a, b, 1e-13, stack, panels)
+            if npan < 0:
+                onb = True      # x on Gamma: the potential is not defined there
+                break
+            for ip in range(npan):
+                s0, s1, dist = panels[ip, 0], panels[ip, 1], panels[ip, 2]
                 h = (s1 - s0) * L
-                t = ((x0 - a[0]) * ux + (x1 - a[1]) * uy) / (L * L)
-                t = min(s1, max(s0, t))
-                dist = math.hypot(x0 - a[0] - t * ux, x1 - a[1] - t * uy)
-                if dist <= 1e-13 * L:
-                    onb = True      # x on Gamma: the potential is not defined there
-                    break
-                if dist < h and top < 60 and h > 1e-14 * L:
-                    m = 0.5 * (s0 + s1)
-                    stack[top, 0], stack[top, 1] = s0, m
-                    stack[top + 1, 0], stack[top + 1, 1] = m, s1
-                    top += 2
-                    continue
                 n = _order(2.0 * dist / h, deg, nmax)
                 for k in range(n):
                     s = s0 + (s1 - s0) * gx[n, k]
