@@ -342,3 +342,284 @@ def test_figure_4_13_setup_smoke():
     assert force > 0
     assert abs(np.sum(fint[ty]) + force) <= 1e-9 * force
     assert np.all(np.abs(res.t_t) <= 0.1 * res.p_n * (1 + 1e-12))
+
+
+# ================================================================ boundary element bodies
+# A body may be a Galerkin BE body (hpfebe.bem.lame.LameBEM): its unknowns are the
+# boundary displacement in V_hp^2, its stiffness the dense S_hat inside the sparse
+# Newton matrix ((4.27) FE/BE, (4.33) BE/BE), its contact traces the GLL Lagrange basis.
+# S_hat reproduces a uniform stress state exactly (linear displacement, piecewise
+# constant traction in W_hp), so the tolerances of the FE tests apply unchanged
+# (measured: pressure and displacement errors 1e-15..4e-15 for p = 1, 2).
+
+from hpfebe.bem.lame import LameBEM  # noqa: E402
+from hpfebe.contact.bem_body import BEBodyAdapter, FEBodyAdapter  # noqa: E402
+from hpfebe.geometry import BoundaryMesh  # noqa: E402
+
+SIDES = ["bottom", "right", "top", "left"]
+
+
+def be_rect(x0, x1, y0, y1, n, p, plane="strain"):
+    """BE body on the rectangle, sides labelled like rectangle_mesh; n elements per side."""
+    mesh = BoundaryMesh.polygon([(x0, y0), (x1, y0), (x1, y1), (x0, y1)], n=n, labels=SIDES, p=p)
+    return LameBEM(mesh, E, NU, plane)
+
+
+def fe_rect(x0, x1, y0, y1, nx, ny, kind="quad"):
+    return ElasticBody(rectangle_mesh(x0, x1, y0, y1, nx, ny, kind), E, NU)
+
+
+def mixed_blocks(combo, p, mu_f=0.0):
+    """Slave [0, 2] x [0, 1], master [0, 2] x [-1, 0]; BE bodies with 4 (slave) and 5
+    (master) elements along the interface (non-matching), 2 on the short sides."""
+    up = be_rect(0, 2, 0, 1, [4, 2, 4, 2], p) if combo[0] == "BE" else fe_rect(0, 2, 0, 1, 4, 3)
+    lo = be_rect(0, 2, -1, 0, [5, 2, 5, 2], p) if combo[1] == "BE" else fe_rect(0, 2, -1, 0, 5, 3)
+    return TwoBodyContact(up, lo, "bottom", "top", eps_n=EPS, eps_t=EPS, mu_f=mu_f)
+
+
+def exact_uniaxial(pr, plane="strain"):
+    """The exact global dof vector of the patch test (slave shifted by eps_n Q)."""
+    exx, eyy = uniaxial_strains(plane)
+    X = pr.dof_coordinates()
+    u = np.zeros(pr.ndofs)
+    for body, off in (("slave", 0), ("master", pr.offset)):
+        ad = pr._adapter(body)
+        if isinstance(ad, FEBodyAdapter):
+            nd = ad.body.nodal_dofs + off
+            dx, dy = nd[0], nd[1]
+        else:
+            dx = np.arange(off, off + ad.ndofs, 2)
+            dy = dx + 1
+        u[dx] = exx * X[dx, 0]
+        u[dy] = eyy * X[dy, 1] + (eyy - EPS * Q if body == "slave" else eyy)
+    return u
+
+
+@pytest.mark.parametrize("combo,p", [(("BE", "FE"), 1), (("BE", "FE"), 2), (("FE", "BE"), 1),
+                                     (("FE", "BE"), 2), (("BE", "BE"), 1), (("BE", "BE"), 2)])
+def test_contact_patch_test_with_boundary_elements(combo, p):
+    pr = mixed_blocks(combo, p)
+    assert isinstance(pr.K, type(pr.Gn))          # one sparse matrix, BE block inside
+    res = patch_solve(pr)
+    assert res.converged, res.reason
+    assert np.all(res.state != OPEN)
+    assert np.max(np.abs(res.p_n / Q - 1)) < TOL
+    assert abs(np.sum(res.weights * res.p_n) / (2 * Q) - 1) < TOL
+    uex = exact_uniaxial(pr)
+    assert np.max(np.abs(res.U - uex)) < TOL * np.abs(uex).max()
+    # the second load step (same active set) is solved by one Newton step to rounding
+    assert res.steps[-1].iterations == 1 and res.steps[-1].residuals[-1] < 1e-12 * res.steps[-1].residuals[0]
+    # contact traces evaluated through the adapter: slave above master by eps_n Q
+    us = pr.displacement_at("slave", res.U, "bottom", [0.0, 0.3, 1.0])
+    exx, eyy = uniaxial_strains("strain")
+    assert np.allclose(us[:, 1], eyy - EPS * Q, rtol=0, atol=TOL * EPS * Q)
+    # interior stress of a BE body from the Somigliana identity: sigma = diag(0, -Q)
+    for body in ("slave", "master"):
+        b = pr._body(body)
+        if isinstance(b, LameBEM):
+            u = res.U[pr.global_dofs(body, np.arange(2 * b.V_space.ndof))]
+            y = 0.5 if body == "slave" else -0.5
+            sig = b.stress([(1.0, y), (0.7, y)], u, b.Psi(u))
+            assert np.allclose(sig, [[0, 0], [0, -Q]], rtol=0, atol=1e-6 * Q)
+
+
+@pytest.mark.parametrize("combo", [("BE", "FE"), ("FE", "BE")])
+def test_stick_below_coulomb_bound_fe_be(combo):
+    pr = mixed_blocks(combo, 2, mu_f=MU)
+    tau = 0.5 * MU * Q
+    fixed = np.concatenate([pr.dofs_on("master", "bottom", 1), pr.dofs_at("master", (0, -1), 0)])
+    res = pr.solve(shear_loads(pr, tau, (tau, -Q)), fixed, None, load_factors=[0.5, 1.0])
+    assert res.converged, res.reason
+    assert np.all(res.state == STICK)
+    assert np.max(np.abs(res.p_n / Q - 1)) < TOL
+    assert np.max(np.abs(res.t_t / tau - 1)) < TOL
+    assert np.all(np.abs(res.t_t) < MU * res.p_n)
+    assert np.max(np.abs(res.g_t / (EPS * tau) - 1)) < 1e-6
+
+
+@pytest.mark.parametrize("combo", [("BE", "FE"), ("FE", "BE"), ("BE", "BE")])
+def test_slip_at_coulomb_bound_fe_be(combo):
+    pr = mixed_blocks(combo, 1, mu_f=MU)
+    tau, c = MU * Q, 2e-3
+    exx, _ = uniaxial_strains("strain")
+    top = pr.dofs_on("slave", "top", 0)
+    base = np.concatenate([pr.dofs_on("master", "bottom", 1), pr.dofs_at("master", (0, -1), 0)])
+    fixed = np.concatenate([base, top])
+    vals = np.concatenate([np.zeros(base.size), exx * pr.dof_coordinates()[top, 0] + c])
+    res = pr.solve(shear_loads(pr, tau, (0.0, -Q)), fixed, vals, load_factors=[0.5, 1.0])
+    assert res.converged, res.reason
+    assert np.all(res.state == SLIP)
+    assert np.max(np.abs(res.p_n / Q - 1)) < TOL
+    assert np.max(np.abs(res.t_t / (MU * res.p_n) - 1)) < TOL
+    assert np.allclose(res.slip, res.g_t - EPS * res.t_t, rtol=0, atol=1e-12 * c)
+    gamma = tau / (E / (2 * (1 + NU)))
+    assert np.max(np.abs(res.g_t / (c - 2 * gamma) - 1)) < TOL
+
+
+def be_punch(master="FE", p=2):
+    """The punch scene of :func:`punch` with a BE slave punch (6 elements along the
+    contact side, 4 on the others, degree p) on the FE master, or on a BE master."""
+    lower = (ElasticBody(rectangle_mesh(0, 2, -1, 0, 10, 5, "tri"), E, NU) if master == "FE"
+             else be_rect(0, 2, -1, 0, [10, 5, 10, 5], p))
+    upper = be_rect(0.5, 1.5, 0, 1, [6, 4, 6, 4], p)
+    pr = TwoBodyContact(upper, lower, "bottom", "top", eps_n=EPS, eps_t=EPS, mu_f=MU)
+    d, s = 1e-3, 1.5e-3
+    tx, ty = pr.dofs_on("slave", "top", 0), pr.dofs_on("slave", "top", 1)
+    clamp = pr.dofs_on("master", "bottom")
+    fixed = np.concatenate([clamp, tx, ty])
+
+    def values(lam):
+        return np.concatenate([np.zeros(clamp.size), np.full(tx.size, s * max(lam - 1, 0)),
+                               np.full(ty.size, -d * min(lam, 1))])
+
+    return pr, fixed, values
+
+
+@pytest.mark.parametrize("master", ["FE", "BE"])
+def test_newton_converges_quadratically_be_punch(master):
+    """BE punch pressed and dragged: stick, a stick-slip front, full slip.  Measured
+    (FE master, p = 2): 1 iteration per pressing step (residual 1e2 -> 1e-13), 3 in the
+    shear steps, e.g. 9.9e1, 1.4e0, 3.7e-1, 2.2e-13 (active/stick sets found, then the
+    piecewise linear problem is solved exactly); BE master: 9.9e1, 4.2e-1, 1.7e-1, 1.6e-13."""
+    pr, fixed, values = be_punch(master)
+    res = pr.solve(None, fixed, values, load_factors=np.linspace(0.25, 2.0, 8))
+    assert res.converged, res.reason
+    assert max(res.iterations) <= 4
+    assert any(st.n_stick > 0 and st.n_slip > 0 for st in res.steps)
+    assert np.all(res.state == SLIP)
+    assert np.max(np.abs(np.abs(res.t_t) - MU * res.p_n)) <= 1e-9 * MU * res.p_n.max()
+    multi = [st.residuals for st in res.steps if st.iterations >= 2]
+    assert multi and all(quadratic_last_step(r) for r in multi)
+    for st in res.steps:
+        assert st.residuals[-1] <= 1e-12 * st.residuals[0]
+
+
+def test_tangent_matches_finite_differences_be():
+    """Consistent Newton matrix with a dense BE block (BE slave on a BE master)."""
+    pr, fixed, values = be_punch("BE", p=2)
+    rng = np.random.default_rng(2)
+    res = pr.solve(None, fixed, values, load_factors=[0.5, 1.0, 1.5])
+    U = res.U + 2e-5 * rng.standard_normal(pr.ndofs)
+    f0, cs = pr.internal_force(U, res.slip)
+    assert {STICK, SLIP} <= set(np.unique(cs["state"]))
+    A = pr.tangent(cs)
+    h = 1e-10
+    for _ in range(3):
+        v = rng.standard_normal(pr.ndofs)
+        fp, csp = pr.internal_force(U + h * v, res.slip)
+        fm, csm = pr.internal_force(U - h * v, res.slip)
+        assert np.array_equal(csp["state"], cs["state"]) and np.array_equal(csm["state"], cs["state"])
+        assert np.linalg.norm((fp - fm) / (2 * h) - A @ v) <= 1e-6 * np.linalg.norm(A @ v)
+
+
+def test_be_adapter_bad_input():
+    up, lo = be_rect(0, 2, 0, 1, 2, 1), fe_rect(0, 2, -1, 0, 3, 1)
+    with pytest.raises(ValueError, match="boundary label"):
+        TwoBodyContact(up, lo, "botom", "top", eps_n=EPS)
+    with pytest.raises(ValueError, match="slave"):
+        TwoBodyContact(up.mesh, lo, "bottom", "top", eps_n=EPS)
+    pr = TwoBodyContact(up, lo, "bottom", "top", eps_n=EPS)
+    assert isinstance(pr.adapters["slave"], BEBodyAdapter)
+    with pytest.raises(ValueError, match="point"):
+        pr.dofs_at("slave", (0.3, 0.3))
+    with pytest.raises(ValueError, match="component"):
+        pr.dofs_on("slave", "top", 2)
+    with pytest.raises(ValueError, match="traction"):
+        pr.traction_load("slave", "top", (1.0, 2.0, 3.0))
+
+
+# ---------------------------------------------------------------- globalisation
+def figure_4_13_coarse():
+    """The Figure 4.13 scene on the initial mesh h = 1/2 (P1 triangles: slave 2 x 4 cells,
+    master 8 x 4 cells), 1/eps_n = 10 E, 1/eps_t = 5 E, mu_f = 0.1."""
+    slave = ElasticBody(rectangle_mesh(-0.5, 0.5, 0, 2, 2, 4, "tri"), E, NU)
+    master = ElasticBody(rectangle_mesh(-2, 2, -2, 0, 8, 4, "tri"), E, NU)
+    pr = TwoBodyContact(slave, master, ["bottom", "left", "right"], ["top", "left", "right"],
+                        eps_n=1 / (10 * E), eps_t=1 / (5 * E), mu_f=0.1)
+    top = pr.dofs_on("slave", "top")
+    bx, by = pr.dofs_on("master", "bottom", 0), pr.dofs_on("master", "bottom", 1)
+    fixed = np.concatenate([top, bx, by])
+    vals = np.concatenate([np.zeros(top.size + bx.size), np.full(by.size, 5e-4)])
+    return pr, fixed, vals
+
+
+def test_line_search_breaks_the_two_state_newton_cycle():
+    """Plain semismooth Newton cycles between two stick/slip states in the first load
+    step (measured residuals 9.6e1, 7.4e-1, 1.0e0, 1.667, 1.656, 1.667, 1.656, ...).
+    With the Armijo backtracking on ||R_free|| (the residual is piecewise linear in U,
+    so along the Newton direction of the current piece it decreases like (1 - alpha)
+    for small alpha: the search always succeeds and the residual decreases monotonically,
+    which excludes the cycle) it converges: measured 7 iterations, step lengths
+    1, 1/4, 1/8, 1, 1/8, 1/16, 1 and a last full step to 5.5e-14 in the first step,
+    then 4, 2, 2, 2 iterations."""
+    pr, fixed, vals = figure_4_13_coarse()
+    lf = np.linspace(0.2, 1.0, 5)
+    plain = pr.solve(None, fixed, vals, load_factors=lf, max_iter=20)
+    assert not plain.converged and "max_iter" in plain.reason
+    r = np.asarray(plain.steps[0].residuals[-6:])
+    assert np.allclose(r[:-2], r[2:], rtol=1e-6)            # period-2 cycle
+    res = pr.solve(None, fixed, vals, load_factors=lf, max_iter=20, line_search=True)
+    assert res.converged, res.reason
+    assert max(res.iterations) <= 10
+    first = res.steps[0]
+    assert min(first.step_lengths) < 1                         # damping was needed
+    assert first.step_lengths[-1] == 1.0                       # ... not at the end
+    assert all(np.all(np.diff(st.residuals) < 0) for st in res.steps)   # monotone
+    for st in res.steps:
+        assert st.residuals[-1] <= 1e-10 * st.residuals[0]
+    assert np.all(np.abs(res.t_t) <= 0.1 * res.p_n * (1 + 1e-12))
+    last = res.steps[-1]
+    assert last.n_stick > 0 and last.n_slip > 0
+    # equilibrium: the reaction at the slave's top equals the contact force
+    fint, _ = pr.internal_force(res.U, res.slip)
+    ty = pr.dofs_on("slave", "top", 1)
+    force = np.sum(res.weights * (res.p_n * pr.normals[:, 1] - res.t_t * pr.tangents[:, 1]))
+    assert force > 0 and abs(np.sum(fint[ty]) + force) <= 1e-9 * force
+
+
+def test_line_search_keeps_full_steps_when_they_decrease_the_residual():
+    pr, fixed, values = punch()
+    a = pr.solve(None, fixed, values, load_factors=np.linspace(0.25, 2.0, 8))
+    b = pr.solve(None, fixed, values, load_factors=np.linspace(0.25, 2.0, 8), line_search=True)
+    assert b.converged and b.iterations == a.iterations
+    assert all(l == 1.0 for st in b.steps for l in st.step_lengths)
+    assert np.allclose(a.U, b.U, rtol=0, atol=1e-12 * np.abs(a.U).max())
+    with pytest.raises(ValueError, match="min_step"):
+        pr.solve(None, fixed, values, min_step=0.0)
+
+
+@pytest.mark.parametrize("combo,plain_fails", [(("BE", "FE"), True), (("FE", "BE"), True),
+                                               (("BE", "BE"), False)])
+def test_figure_4_13_coarse_with_boundary_elements(combo, plain_fails):
+    """The h = 1/2 scene with BE bodies (p = 1, elements of length 1/2; FE bodies P1
+    triangles).  Measured: plain Newton hits max_iter for BE/FE (load step 5) and FE/BE
+    (step 2); with the line search all three converge in <= 4 iterations per step
+    (e.g. FE/BE step 1: 2.8e1, 7.7e-1, 4.9e-1, 3.1e-1, 2.0e-14), one slave point sticks
+    at the centre (BE/BE: none), the bottom corners slip, the slave's sides stay open."""
+    h = 0.5
+    s = (be_rect(-0.5, 0.5, 0, 2, [2, 4, 2, 4], 1) if combo[0] == "BE"
+         else fe_rect(-0.5, 0.5, 0, 2, 2, 4, "tri"))
+    m = (be_rect(-2, 2, -2, 0, [8, 4, 8, 4], 1) if combo[1] == "BE"
+         else fe_rect(-2, 2, -2, 0, 8, 4, "tri"))
+    assert np.isclose(2 / 4, h)
+    pr = TwoBodyContact(s, m, ["bottom", "left", "right"], ["top", "left", "right"],
+                        eps_n=1 / (10 * E), eps_t=1 / (5 * E), mu_f=0.1)
+    top = pr.dofs_on("slave", "top")
+    bx, by = pr.dofs_on("master", "bottom", 0), pr.dofs_on("master", "bottom", 1)
+    fixed = np.concatenate([top, bx, by])
+    vals = np.concatenate([np.zeros(top.size + bx.size), np.full(by.size, 5e-4)])
+    lf = np.linspace(0.2, 1.0, 5)
+    plain = pr.solve(None, fixed, vals, load_factors=lf, max_iter=30)
+    assert plain.converged != plain_fails
+    res = pr.solve(None, fixed, vals, load_factors=lf, max_iter=30, line_search=True)
+    assert res.converged, res.reason
+    assert max(res.iterations) <= 4
+    assert all(np.all(np.diff(st.residuals) < 0) for st in res.steps)
+    assert all(st.residuals[-1] <= 1e-10 * st.residuals[0] for st in res.steps)
+    side = np.abs(np.abs(res.points[:, 0]) - 0.5) < 1e-12
+    assert np.all(res.state[side] == OPEN) and np.any(res.state == SLIP)
+    assert np.all(np.abs(res.t_t) <= 0.1 * res.p_n * (1 + 1e-12))
+    fint, _ = pr.internal_force(res.U, res.slip)
+    ty = pr.dofs_on("slave", "top", 1)
+    force = np.sum(res.weights * (res.p_n * pr.normals[:, 1] - res.t_t * pr.tangents[:, 1]))
+    assert force > 0 and abs(np.sum(fint[ty]) + force) <= 1e-8 * force

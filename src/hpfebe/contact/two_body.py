@@ -1,15 +1,26 @@
-"""Two elastic FE bodies in penalty contact with Coulomb friction on non-matching meshes
+"""Two elastic bodies in penalty contact with Coulomb friction on non-matching meshes
 (Chapter 4, Section 4.2: master-slave gap (4.18), constitutive laws (4.19)-(4.20), the
-return map of Section 4.2.5, Newton with load increments, Algorithm 4.1, block system
-(4.27)).
+return map of Section 4.2.5, Newton with load increments, Algorithm 4.1, block systems
+(4.27) FE/BE and (4.33) BE/BE).
+
+Bodies.  Each body is either a P1/Q1 finite element body
+(:class:`hpfebe.fem.elasticity.ElasticBody`) or a Galerkin boundary element body
+(:class:`hpfebe.bem.lame.LameBEM` on a labelled :class:`hpfebe.geometry.BoundaryMesh`).
+The contact code below is written once; what depends on the discretisation (stiffness,
+contact segments, traces at the contact points, boundary conditions and loads) comes
+from a body adapter (:mod:`hpfebe.contact.bem_body`).  A BE body's unknowns are its
+boundary displacement in V_hp^2 (interleaved components), its stiffness the dense
+discrete Steklov-Poincare operator S_hat, its traces the GLL Lagrange basis of degree p.
 
 Unknowns and block structure.  One dof vector U = (U^s, U^m): the slave body's dofs first,
-then the master's (offset ``slave.ndofs``), as in (4.27).  The Newton matrix is
+then the master's (offset = the slave's ndofs), as in (4.27)/(4.33).  The Newton matrix is
 
     [ K^s + C_ss    -C_sm     ]
     [ -C_ms         K^m + C_mm]   (signs absorbed in the coupling matrices below),
 
-K^s, K^m the FE stiffness matrices, C the linearised contact terms (all sparse).
+K^b the FE stiffness (sparse) or S_hat (dense, stored as a fully populated block of the
+one sparse matrix, so that FE blocks stay sparse), C the linearised contact terms
+(sparse); each Newton system is solved by a sparse LU (scipy.sparse.linalg.splu).
 
 Contact points. The thesis evaluates the gap at slave points x^s and leaves the
 integration of the contact terms open. Ours (segment-based Gauss-point-to-segment):
@@ -70,9 +81,20 @@ U -> dg_n, dg_t at the points, W diagonal) is the exact (generalised) derivative
 R; it is non-symmetric in slip.  Points with g_n > 0 are open: p_n = t_t = 0 (their
 slip follows the relative motion, g_t^p <- g_t).  With mu_f = 0 (frictionless) the
 tangential terms vanish and active points are reported as SLIP (t_t = 0 = mu_f p_n).
-Semismooth Newton without globalisation: in the piecewise linear setting it terminates
-once the active and stick/slip sets are right (the last step drops the residual to
-rounding); changes of those sets may take a few non-monotone iterations.
+Semismooth Newton: in the piecewise linear setting it terminates once the active and
+stick/slip sets are right (the last step drops the residual to rounding); changes of
+those sets may take a few non-monotone iterations - or cycle forever between two sets
+(measured: the Figure 4.13 scene on its initial mesh h = 1/2 with P1 triangles).
+Globalisation (``line_search=True``, off by default so that the plain iteration of the
+thesis is what runs unless asked for): Armijo backtracking alpha = 1, 1/2, 1/4, ... on
+the merit ||R_free||_2, accepting ||R(U + alpha dU)|| <= (1 - 1e-4 alpha) ||R(U)||.
+Justification: R is piecewise linear in U and dU solves the Newton system of the current
+piece, so for small alpha ||R(U + alpha dU)|| = (1 - alpha) ||R(U)|| (when U is interior
+to its piece; on a kink the one-sided derivative of the new piece enters): the search
+succeeds, the residual decreases strictly, and a state once left cannot be met again
+with the same residual - no cycle; near the solution the full step is accepted and the
+finite termination is kept.  Below ``min_step`` the last trial step is taken.  Non-
+symmetric in slip, the problem has no energy, hence the residual as merit.
 
 Algorithm 4.1: for every load factor lambda_j the external load F_ext(lambda_j) and the
 Dirichlet values (both arrays scaled by lambda, or callables of lambda) are applied, the
@@ -94,8 +116,10 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
+from ..bem.lame import LameBEM
 from ..fem.elasticity import ElasticBody
 from ..quadrature import gauss_legendre
+from .bem_body import make_adapter
 
 OPEN, STICK, SLIP = 0, 1, 2
 STATE_NAMES = {OPEN: "open", STICK: "stick", SLIP: "slip"}
@@ -135,7 +159,8 @@ def project_onto_polyline(points: np.ndarray, a: np.ndarray, b: np.ndarray):
 @dataclass
 class StepRecord:
     """Diagnostics of one load step: load factor, Newton iterations, residual norms
-    ||R_free||_2 of every iterate (index 0 = start iterate), outcome."""
+    ||R_free||_2 of every iterate (index 0 = start iterate), outcome, contact state
+    counts of the last iterate and the Newton step lengths (all 1 without line search)."""
 
     load_factor: float
     iterations: int
@@ -145,6 +170,7 @@ class StepRecord:
     n_stick: int = 0
     n_slip: int = 0
     n_open: int = 0
+    step_lengths: list = None
 
 
 @dataclass
@@ -191,22 +217,25 @@ class TwoBodyResult:
 
 
 class TwoBodyContact:
-    """Slave and master elastic FE bodies in frictional penalty contact.
+    """Slave and master elastic bodies (FE or BE) in frictional penalty contact.
 
     Parameters
     ----------
-    slave, master : :class:`hpfebe.fem.elasticity.ElasticBody`
+    slave, master : :class:`hpfebe.fem.elasticity.ElasticBody` (FE) or
+        :class:`hpfebe.bem.lame.LameBEM` (BE)
     slave_boundary, master_boundary : labels (str or list) of Gamma_C^s, Gamma_C^m
+        (FE: facet labels of the mesh; BE: element labels of the boundary mesh)
     eps_n, eps_t : penalty parameters (> 0); 1/eps are the contact stiffnesses
     mu_f : Coulomb friction coefficient (>= 0; 0 = frictionless: no tangential terms)
-    nq : Gauss points per slave facet (>= 1; 2 integrates the P1/Q1 trace products
-        exactly on the slave side)
+    nq : Gauss points per integration piece (>= 1; 2 integrates the P1/Q1 trace
+        products exactly; with a BE body at least p_max + 1 are taken)
+    split : split the slave segments at the projections of the master vertices
     """
 
     def __init__(
         self,
-        slave: ElasticBody,
-        master: ElasticBody,
+        slave: Union[ElasticBody, LameBEM],
+        master: Union[ElasticBody, LameBEM],
         slave_boundary: Union[str, Sequence[str]],
         master_boundary: Union[str, Sequence[str]],
         eps_n: float,
@@ -215,10 +244,10 @@ class TwoBodyContact:
         nq: int = 2,
         split: bool = True,
     ):
-        if not isinstance(slave, ElasticBody):
-            raise ValueError(f"slave must be an ElasticBody, got {type(slave).__name__}")
-        if not isinstance(master, ElasticBody):
-            raise ValueError(f"master must be an ElasticBody, got {type(master).__name__}")
+        if not isinstance(slave, (ElasticBody, LameBEM)):
+            raise ValueError(f"slave must be an ElasticBody or a LameBEM, got {type(slave).__name__}")
+        if not isinstance(master, (ElasticBody, LameBEM)):
+            raise ValueError(f"master must be an ElasticBody or a LameBEM, got {type(master).__name__}")
         self.eps_n = _positive("eps_n", eps_n)
         self.eps_t = _positive("eps_t", eps_t)
         mu = float(mu_f)
@@ -230,38 +259,40 @@ class TwoBodyContact:
         self.nq = int(nq)
         self.split = bool(split)
         self.slave, self.master = slave, master
-        self.offset = slave.ndofs
-        self.ndofs = slave.ndofs + master.ndofs
-        self.K = sp.block_diag([slave.K, master.K], format="csr")
+        self.adapters = {"slave": make_adapter(slave), "master": make_adapter(master)}
+        sa, ma = self.adapters["slave"], self.adapters["master"]
+        self.offset = sa.ndofs
+        self.ndofs = sa.ndofs + ma.ndofs
+        # (4.27) / (4.33): FE blocks sparse, a BE block (dense S_hat) stored inside
+        self.K = sp.block_diag([sa.K, ma.K], format="csr")
         self._build_contact(slave_boundary, master_boundary)
 
     # ------------------------------------------------------------------ geometry
-    @staticmethod
-    def _facets(body: ElasticBody, labels) -> np.ndarray:
-        if isinstance(labels, str):
-            labels = [labels]
-        return np.unique(np.concatenate([body.boundary_facets(lb) for lb in labels]))
-
     def _build_contact(self, slave_boundary, master_boundary) -> None:
-        S, M = self.slave, self.master
-        fs = self._facets(S, slave_boundary)
-        fm = self._facets(M, master_boundary)
-        ma, mb = M.mesh.facets[0, fm], M.mesh.facets[1, fm]
-        A, B = M.mesh.p[:, ma].T, M.mesh.p[:, mb].T
-        va, vb = S.mesh.facets[0, fs], S.mesh.facets[1, fs]
-        xa, xb = S.mesh.p[:, va].T, S.mesh.p[:, vb].T          # (nf, 2)
-        # integration segments: every slave facet is split where a master vertex projects
-        # onto it, so that slave and master traces are both linear on each piece
-        mverts = np.unique(np.concatenate([ma, mb]))
-        mseg, ms, mexc, _ = project_onto_polyline(M.mesh.p[:, mverts].T, xa, xb)
+        S, M = self.adapters["slave"], self.adapters["master"]
+        ssg = S.segments(slave_boundary)
+        msg = M.segments(master_boundary)
+        fs, xa, xb = ssg["ids"], ssg["a"], ssg["b"]
+        A, B, ma, mb = msg["a"], msg["b"], msg["va"], msg["vb"]
+        # integration segments: every slave segment is split where a master vertex
+        # projects onto it, so that slave and master traces are both polynomial on each
+        # piece (a BE trace of degree p needs p + 1 Gauss points per piece)
+        mpts = np.vstack([A, B])
+        mseg, ms, mexc, _ = project_onto_polyline(mpts, xa, xb)
         inner = (mexc == 0) & (ms > 1e-12) & (ms < 1 - 1e-12)
         if not self.split:
             inner[:] = False
-        t, w = gauss_legendre(self.nq)
+        nq = self.nq
+        if S.kind == "BE" or M.kind == "BE":
+            nq = max(nq, max(S.degree, M.degree) + 1)
+        t, w = gauss_legendre(nq)
         t, w = np.asarray(t, dtype=float), np.asarray(w, dtype=float)
         pf, ps, pw = [], [], []
         for i in range(fs.size):
             br = np.unique(np.concatenate([[0.0, 1.0], ms[inner & (mseg == i)]]))
+            # drop breakpoints closer than rounding (a master vertex seen from two segments)
+            br = br[np.concatenate([[True], np.diff(br) > 1e-12])]
+            br[-1] = 1.0
             lo, hi = br[:-1], br[1:]
             sp_ = (lo[:, None] + 0.5 * (1 + t)[None, :] * (hi - lo)[:, None]).ravel()
             pf.append(np.full(sp_.size, i))
@@ -271,18 +302,17 @@ class TwoBodyContact:
         length = np.linalg.norm(xb - xa, axis=1)
         pts = xa[pf] + ps[:, None] * (xb[pf] - xa[pf])
         wts = pw * length[pf]
-        sva, svb = va[pf], vb[pf]
-        spa, spb = 1.0 - ps, ps
         self.point_facets = fs[pf]
         # master segments
-        normals = M.outward_normals(fm).T                        # (nm, 2)
+        normals = msg["normals"]
         seg, s, excess, _ = project_onto_polyline(pts, A, B)
         seg_len = np.linalg.norm(B - A, axis=1)
         # outside: clipped onto an end vertex of the master polyline (a vertex of one
-        # master facet only); clipped onto an inner corner vertex is a valid contact
-        counts = np.bincount(np.concatenate([ma, mb]), minlength=M.mesh.p.shape[1])
-        vert = np.where(s < 0.5, ma[seg], mb[seg])
-        outside = (excess * seg_len[seg] > 1e-10 * seg_len.max()) & (counts[vert] == 1)
+        # master segment only); clipped onto an inner corner vertex is a valid contact
+        verts, inv = np.unique(np.concatenate([ma, mb]), return_inverse=True)
+        counts = np.bincount(inv)
+        vid = np.where(s < 0.5, inv[seg], inv[ma.size + seg])
+        outside = (excess * seg_len[seg] > 1e-10 * seg_len.max()) & (counts[vid] == 1)
         nm = normals[seg]
         tm = np.column_stack([nm[:, 1], -nm[:, 0]])
         xm = A[seg] + s[:, None] * (B[seg] - A[seg])
@@ -292,22 +322,19 @@ class TwoBodyContact:
         self.normals, self.tangents = nm, tm
         self.master_points = xm
         self.g0 = np.sum((pts - xm) * nm, axis=1)
-        # sparse maps U -> dg_n, dg_t: rows = points, 8 entries each
+        # sparse maps U -> dg_n, dg_t: rows = points, one entry per trace basis function,
+        # component and side (the adapters' traces)
         n = pts.shape[0]
-        Sd, Md = S.nodal_dofs, M.nodal_dofs
-        mva, mvb = ma[seg], mb[seg]
         rows, cols, vn, vt = [], [], [], []
-        for dofs, phi, sign in (
-            (Sd[:, sva], spa, 1.0),
-            (Sd[:, svb], spb, 1.0),
-            (Md[:, mva] + self.offset, 1.0 - s, -1.0),
-            (Md[:, mvb] + self.offset, s, -1.0),
-        ):
-            for c in (0, 1):
-                rows.append(np.arange(n))
-                cols.append(dofs[c])
-                vn.append(sign * phi * nm[:, c])
-                vt.append(sign * phi * tm[:, c])
+        for ad, ids, par, off, sign in ((S, fs[pf], ps, 0, 1.0),
+                                        (M, msg["ids"][seg], s, self.offset, -1.0)):
+            tc, tv = ad.trace(ids, par)
+            for j in range(tv.shape[1]):
+                for c in (0, 1):
+                    rows.append(np.arange(n))
+                    cols.append(tc[:, c, j] + off)
+                    vn.append(sign * tv[:, j] * nm[:, c])
+                    vt.append(sign * tv[:, j] * tm[:, c])
         rows, cols = np.concatenate(rows), np.concatenate(cols)
         shape = (n, self.ndofs)
         self.Gn = sp.csr_matrix((np.concatenate(vn), (rows, cols)), shape=shape)
@@ -323,29 +350,41 @@ class TwoBodyContact:
         raise ValueError(f"body must be 'slave' or 'master', got {body!r}")
 
     def dofs_on(self, body: str, labels, component: Optional[int] = None) -> np.ndarray:
-        b = self._body(body)
-        return self.global_dofs(body, b.dofs_on(labels, component))
+        return self.global_dofs(body, self._adapter(body).dofs_on(labels, component))
 
     def dofs_at(self, body: str, point, component: Optional[int] = None) -> np.ndarray:
-        b = self._body(body)
-        return self.global_dofs(body, b.dofs_at(point, component))
+        return self.global_dofs(body, self._adapter(body).dofs_at(point, component))
 
     def traction_load(self, body: str, label: str, traction) -> np.ndarray:
         """Global load vector of a traction on the boundary part ``label`` of ``body``."""
-        b = self._body(body)
+        ad = self._adapter(body)
         f = np.zeros(self.ndofs)
-        f[self.global_dofs(body, np.arange(b.ndofs))] = b.traction_load(label, traction)
+        f[self.global_dofs(body, np.arange(ad.ndofs))] = ad.traction_load(label, traction)
         return f
 
     def dof_coordinates(self) -> np.ndarray:
-        return np.vstack([self.slave.dof_coordinates(), self.master.dof_coordinates()])
+        return np.vstack([self.adapters["slave"].dof_coordinates(),
+                          self.adapters["master"].dof_coordinates()])
 
-    def _body(self, body: str) -> ElasticBody:
-        if body == "slave":
-            return self.slave
-        if body == "master":
-            return self.master
+    def displacement_at(self, body: str, U: np.ndarray, labels, s) -> np.ndarray:
+        """(n, 2) displacement of ``body`` (global dof vector U) at the points
+        a + s (b - a) of its segments on ``labels`` (n = number of segments x len(s))."""
+        ad = self._adapter(body)
+        sg = ad.segments(labels)
+        s = np.atleast_1d(np.asarray(s, dtype=float))
+        ids = np.repeat(sg["ids"], s.size)
+        par = np.tile(s, sg["ids"].size)
+        tc, tv = ad.trace(ids, par)
+        u = np.asarray(U)[self.global_dofs(body, np.arange(ad.ndofs))]
+        return np.einsum("nj,ncj->nc", tv, u[tc])
+
+    def _adapter(self, body: str):
+        if body in ("slave", "master"):
+            return self.adapters[body]
         raise ValueError(f"body must be 'slave' or 'master', got {body!r}")
+
+    def _body(self, body: str):
+        return self._adapter(body).body
 
     # ------------------------------------------------------------------ contact law
     def contact_state(self, U: np.ndarray, slip: np.ndarray):
@@ -400,13 +439,17 @@ class TwoBodyContact:
         rtol: float = 1e-10,
         atol: float = 0.0,
         max_iter: int = 30,
+        line_search: bool = False,
+        min_step: float = 2.0 ** -12,
     ) -> TwoBodyResult:
         """Incremental loading with Newton's method (Algorithm 4.1).
 
         ``f_ext`` (global load vector at load factor 1, scaled by lambda, or a callable
         lambda -> vector), ``fixed_dofs`` (global Dirichlet dofs) with ``fixed_values``
         (values at lambda = 1, scaled; a callable lambda -> values; None = 0),
-        ``load_factors`` increasing pseudo-times lambda_1 < lambda_2 < ..."""
+        ``load_factors`` increasing pseudo-times lambda_1 < lambda_2 < ...;
+        ``line_search`` Armijo backtracking on ||R_free|| (module docstring) down to
+        step length ``min_step``; the step lengths are in ``StepRecord.step_lengths``."""
         N = self.ndofs
         lf = np.asarray(load_factors, dtype=float).ravel()
         if lf.size == 0 or not np.all(np.isfinite(lf)):
@@ -421,6 +464,9 @@ class TwoBodyContact:
             raise ValueError("rtol and atol must not both be zero")
         if int(max_iter) != max_iter or max_iter < 1:
             raise ValueError(f"max_iter must be a positive integer, got {max_iter!r}")
+        min_step = float(min_step)
+        if not (np.isfinite(min_step) and 0 < min_step <= 1):
+            raise ValueError(f"min_step must lie in (0, 1], got {min_step!r}")
         fixed = np.asarray([] if fixed_dofs is None else fixed_dofs, dtype=np.int64).ravel()
         if fixed.size and (fixed.min() < 0 or fixed.max() >= N):
             raise ValueError(f"fixed_dofs must lie in [0, {N}), got range [{fixed.min()}, {fixed.max()}]")
@@ -458,8 +504,9 @@ class TwoBodyContact:
             ref = None
             res_hist: list = []
             ok, why = False, ""
+            lengths: list = []
+            fint, cs = self.internal_force(U, slip)
             for k in range(int(max_iter) + 1):
-                fint, cs = self.internal_force(U, slip)
                 r = (f - fint)[free]
                 rn = float(np.linalg.norm(r))
                 res_hist.append(rn)
@@ -478,7 +525,7 @@ class TwoBodyContact:
                 try:
                     with warnings.catch_warnings():
                         warnings.simplefilter("ignore", spla.MatrixRankWarning)
-                        dU = spla.spsolve(A, r)
+                        dU = spla.splu(A).solve(r)
                 except RuntimeError:
                     dU = np.full(free.size, np.nan)
                 if not np.all(np.isfinite(dU)) or (
@@ -486,11 +533,24 @@ class TwoBodyContact:
                 ):
                     why = f"singular Newton matrix in step {j}"
                     break
-                U[free] += dU
+                alpha = 1.0
+                while True:
+                    Ut = U.copy()
+                    Ut[free] += alpha * dU
+                    fint_t, cs_t = self.internal_force(Ut, slip)
+                    rt = float(np.linalg.norm((f - fint_t)[free]))
+                    # Armijo on the merit ||R_free||_2 (the full step always when
+                    # line_search is off); below min_step the last trial is taken
+                    if (not line_search or rt <= (1.0 - 1e-4 * alpha) * rn
+                            or alpha * 0.5 < min_step):
+                        break
+                    alpha *= 0.5
+                lengths.append(alpha)
+                U, fint, cs = Ut, fint_t, cs_t
             st = cs["state"]
             steps.append(StepRecord(float(lam), len(res_hist) - 1, res_hist, ok, why,
                                     int(np.sum(st == STICK)), int(np.sum(st == SLIP)),
-                                    int(np.sum(st == OPEN))))
+                                    int(np.sum(st == OPEN)), lengths))
             if not ok:
                 converged, reason = False, why
                 break

@@ -1,0 +1,214 @@
+"""Body adapters for :class:`hpfebe.contact.two_body.TwoBodyContact`: one small interface
+that hides whether a contact body is discretised by finite elements (P1/Q1,
+:class:`hpfebe.fem.elasticity.ElasticBody`) or by boundary elements (Galerkin BEM,
+:class:`hpfebe.bem.lame.LameBEM`), so that the contact code (gap, projection, return map,
+linearisation, Newton) is written once for FE/FE, FE/BE, BE/FE and BE/BE
+(Chapter 4, Section 4.2: block systems (4.27) and (4.33)).
+
+What the contact code needs from a body (the adapter interface):
+
+    ndofs, K                 number of unknowns and stiffness (sparse; for a BE body the
+                             dense S_hat stored as a (fully populated) sparse block, so that
+                             the global Newton matrix stays sparse in its FE blocks)
+    segments(labels)         the straight pieces of the contact boundary: end points a, b,
+                             end vertex ids (for polyline ends), outward unit normals and
+                             the body's own facet / element ids
+    trace(ids, s)            the linear map dofs -> displacement at the points
+                             a + s (b - a) of segments ``ids``: columns (n, 2, k) (dof of
+                             component c of local basis function j) and values (n, k)
+    degree                   polynomial degree of the traces (the contact quadrature
+                             takes degree + 1 Gauss points per piece to be exact)
+    dofs_on / dofs_at / traction_load / dof_coordinates   boundary conditions and loads
+
+FE body: the traces on a facet are the two vertex hat functions (1 - s, s).
+BE body: the unknowns are the boundary displacement in V_hp^2 (continuous Gauss-Lobatto
+Lagrange basis of degree p_I per element, interleaved components 2 * scalar dof + c,
+:mod:`hpfebe.spaces`), its stiffness the discrete Steklov-Poincare operator S_hat
+(Section 1.4); the trace on an element is the GLL Lagrange basis at t = 2 s - 1.
+
+This is the structure of the thesis's systems: in (4.27) (FE/BE, the slave discretised
+by BE) the slave's block is the dense S on its Neumann and contact boundary dofs, the
+master's the sparse FE matrix, and the two are coupled only through the contact blocks C_ss, C_sm, C_ms, C_mm; in (4.33) (BE/BE) both
+body blocks are dense S.  Dirichlet dofs are kept in the vector and eliminated by the
+solver (``fixed_dofs``), not dropped from the space.  Plasticity (A_pl, B_pl of (4.27))
+is not part of this module.
+"""
+
+from __future__ import annotations
+
+from typing import Optional, Sequence
+
+import numpy as np
+import scipy.sparse as sp
+
+from ..bem.lame import LameBEM
+from ..fem.elasticity import ElasticBody
+from ..quadrature import gauss_legendre, gauss_lobatto
+from ..spaces import lagrange_values
+
+
+def _labels(labels) -> list:
+    return [labels] if isinstance(labels, str) else list(labels)
+
+
+class FEBodyAdapter:
+    """Adapter of a P1/Q1 :class:`ElasticBody` (facets of its labelled boundary)."""
+
+    kind = "FE"
+    degree = 1
+
+    def __init__(self, body: ElasticBody):
+        self.body = body
+        self.ndofs = body.ndofs
+        self.K = body.K
+
+    def segments(self, labels):
+        b = self.body
+        f = np.unique(np.concatenate([b.boundary_facets(lb) for lb in _labels(labels)]))
+        va, vb = b.mesh.facets[0, f], b.mesh.facets[1, f]
+        return dict(a=b.mesh.p[:, va].T, b=b.mesh.p[:, vb].T, va=va, vb=vb,
+                    normals=b.outward_normals(f).T, ids=f)
+
+    def trace(self, ids, s):
+        m = self.body.mesh
+        va, vb = m.facets[0, ids], m.facets[1, ids]
+        nd = self.body.nodal_dofs
+        cols = np.stack([np.stack([nd[c, va], nd[c, vb]], axis=1) for c in (0, 1)], axis=1)
+        vals = np.column_stack([1.0 - s, s])
+        return cols, vals
+
+    def dofs_on(self, labels, component=None):
+        return self.body.dofs_on(labels, component)
+
+    def dofs_at(self, point, component=None):
+        return self.body.dofs_at(point, component)
+
+    def traction_load(self, label, traction):
+        return self.body.traction_load(label, traction)
+
+    def dof_coordinates(self):
+        return self.body.dof_coordinates()
+
+
+class BEBodyAdapter:
+    """Adapter of a :class:`LameBEM` body: unknowns = boundary displacement in V_hp^2,
+    stiffness S_hat, contact boundary = the elements carrying the contact labels."""
+
+    kind = "BE"
+
+    def __init__(self, bem: LameBEM):
+        self.body = bem
+        self.mesh = bem.mesh
+        self.space = bem.V_space
+        self.ndofs = 2 * self.space.ndof
+        self.degree = int(self.mesh.degrees.max())
+        self.K = sp.csr_matrix(bem.S_hat)
+
+    def _elements(self, labels) -> np.ndarray:
+        labels = _labels(labels)
+        known = set(np.unique(self.mesh.labels).tolist())
+        for lb in labels:
+            if lb not in known:
+                raise ValueError(f"boundary label must be one of {sorted(known)}, got {lb!r}")
+        return np.flatnonzero(self.mesh.where(*labels))
+
+    def segments(self, labels):
+        e = self._elements(labels)
+        m = self.mesh
+        return dict(a=m.a[e], b=m.b[e], va=m.elements[e, 0], vb=m.elements[e, 1],
+                    normals=m.normals[e], ids=e)
+
+    def trace(self, ids, s):
+        ids = np.asarray(ids)
+        s = np.asarray(s, dtype=float)
+        k = self.degree + 1
+        n = ids.size
+        cols = np.zeros((n, 2, k), dtype=np.int64)
+        vals = np.zeros((n, k))
+        deg = self.mesh.degrees[ids]
+        for p in np.unique(deg):
+            sel = np.flatnonzero(deg == p)
+            p = int(p)
+            vals[sel, :p + 1] = lagrange_values(p, 2.0 * s[sel] - 1.0)
+            d = self.space.elem_dofs[ids[sel], :p + 1]
+            for c in (0, 1):
+                cols[sel, c, :p + 1] = 2 * d + c
+        return cols, vals
+
+    def dofs_on(self, labels, component: Optional[int] = None):
+        d = self.space.dofs_on(*_labels(self._check(labels)))
+        return self._interleave(d, component)
+
+    def _check(self, labels):
+        self._elements(labels)
+        return labels
+
+    @staticmethod
+    def _interleave(d, component):
+        d = np.asarray(d, dtype=np.int64)
+        if component is None:
+            return np.sort(np.concatenate([2 * d, 2 * d + 1]))
+        if component not in (0, 1):
+            raise ValueError(f"component must be 0, 1 or None, got {component!r}")
+        return 2 * d + component
+
+    def dofs_at(self, point: Sequence[float], component: Optional[int] = None):
+        p = np.asarray(point, dtype=float).reshape(1, 2)
+        m = self.mesh
+        dist = np.linalg.norm(m.a - p, axis=1)
+        e = int(np.argmin(dist))
+        if dist[e] > 1e-10 * m.diameter:
+            raise ValueError(f"point must be a boundary mesh node, got {tuple(p.ravel())!r}")
+        return self._interleave(np.array([self.space.elem_dofs[e, 0]]), component)
+
+    def dof_coordinates(self):
+        xy = np.empty((self.ndofs, 2))
+        m = self.mesh
+        for p in np.unique(m.degrees):
+            p = int(p)
+            els = np.flatnonzero(m.degrees == p)
+            xg, _ = gauss_lobatto(p + 1)
+            pts = m.points(els[:, None], xg[None, :])          # (ne, p+1, 2)
+            d = self.space.elem_dofs[els, :p + 1]
+            for c in (0, 1):
+                xy[2 * d + c] = pts
+        return xy
+
+    def traction_load(self, label: str, traction):
+        """int_{Gamma_label} t . v ds for v in V_hp^2 (Gauss-Legendre, p + 3 points);
+        ``traction`` a constant (tx, ty) or a callable (x, y) -> (tx, ty)."""
+        e_all = self._elements(label)
+        if not callable(traction):
+            tc = np.asarray(traction, dtype=float)
+            if tc.shape != (2,):
+                raise ValueError(f"traction must be a pair (tx, ty) or callable, got {traction!r}")
+        m = self.mesh
+        f = np.zeros(self.ndofs)
+        for p in np.unique(m.degrees[e_all]):
+            p = int(p)
+            els = e_all[m.degrees[e_all] == p]
+            tq, wq = gauss_legendre(p + 3)
+            tq, wq = np.asarray(tq, float), np.asarray(wq, float)
+            x = m.points(els[:, None], tq[None, :])             # (ne, nq, 2)
+            if callable(traction):
+                tx, ty = traction(x[..., 0], x[..., 1])
+                tv = np.stack([np.broadcast_to(tx, x.shape[:2]),
+                               np.broadcast_to(ty, x.shape[:2])], axis=-1)
+            else:
+                tv = np.broadcast_to(tc, x.shape)
+            phi = lagrange_values(p, tq)                         # (nq, p+1)
+            w = wq[None, :] * (0.5 * m.lengths[els])[:, None]    # (ne, nq)
+            loc = np.einsum("eq,qj,eqc->ejc", w, phi, tv)        # (ne, p+1, 2)
+            d = self.space.elem_dofs[els, :p + 1]
+            for c in (0, 1):
+                np.add.at(f, 2 * d + c, loc[..., c])
+        return f
+
+
+def make_adapter(body):
+    """The adapter of an FE body (:class:`ElasticBody`) or a BE body (:class:`LameBEM`)."""
+    if isinstance(body, ElasticBody):
+        return FEBodyAdapter(body)
+    if isinstance(body, LameBEM):
+        return BEBodyAdapter(body)
+    raise ValueError(f"body must be an ElasticBody or a LameBEM, got {type(body).__name__}")
