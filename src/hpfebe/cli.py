@@ -15,6 +15,8 @@ import sys
 import time
 from pathlib import Path
 
+from .results import published_file_for
+
 log = logging.getLogger("hpfebe")
 
 EXIT_OK, EXIT_FAILED, EXIT_USAGE = 0, 1, 2
@@ -87,17 +89,6 @@ def load_config(files: list[Path]) -> dict:
                            f"got {type(data).__name__}")
         cfg = merge(cfg, data)
     return cfg
-
-
-def published_file_for(name: str, published_dir: Path) -> Path | None:
-    """report/published/<name>.csv or <name>_*.csv, if there is one."""
-    if not published_dir.is_dir():
-        return None
-    exact = published_dir / f"{name}.csv"
-    if exact.is_file():
-        return exact
-    hits = sorted(published_dir.glob(f"{name}_*.csv"))
-    return hits[0] if hits else None
 
 
 # --------------------------------------------------------------------------- commands

@@ -31,7 +31,7 @@ from pathlib import Path
 
 import pandas as pd
 
-from .results import artefact_kind, atomic_write
+from .results import artefact_kind, atomic_write, published_file_for
 
 __all__ = ["build_report", "compare", "collect"]
 
@@ -208,16 +208,6 @@ def _read_published(path: Path) -> tuple[pd.DataFrame, str]:
     return pd.read_csv(path, comment="#"), caption
 
 
-def _published_for(name: str, published_dir: Path) -> Path | None:
-    if not published_dir.is_dir():
-        return None
-    exact = published_dir / f"{name}.csv"
-    if exact.is_file():
-        return exact
-    hits = sorted(published_dir.glob(f"{name}_*.csv"))
-    return hits[0] if hits else None
-
-
 # --------------------------------------------------------------------------- collecting
 def _judge(entry: Entry) -> str:
     doc = entry.doc or {}
@@ -262,7 +252,7 @@ def collect(results_dir: Path, published_dir: Path,
             status = STATUS_NOT_BUILT if (module or js.exists() or csv.exists()) else (
                 STATUS_NOT_IMPL if name in pub_only else STATUS_NOT_BUILT)
             e = Entry(name, kind, module, status)
-            e.published_path = _published_for(name, published_dir)
+            e.published_path = published_file_for(name, published_dir)
             if e.published_path:
                 try:
                     e.published_table, e.published_caption = _read_published(

@@ -364,3 +364,14 @@ def read_result(results_dir: Path | str, name: str) -> tuple[dict, pd.DataFrame]
     with open(js, encoding="utf-8") as f:
         doc = json.load(f)
     return doc, pd.read_csv(csv)
+
+
+def published_file_for(name: str, published_dir: Path) -> Path | None:
+    """report/published/<name>.csv or <name>_*.csv, if there is one."""
+    if not published_dir.is_dir():
+        return None
+    exact = published_dir / f"{name}.csv"
+    if exact.is_file():
+        return exact
+    hits = sorted(published_dir.glob(f"{name}_*.csv"))
+    return hits[0] if hits else None
