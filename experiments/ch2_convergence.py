@@ -212,9 +212,14 @@ def run(config: dict, quick: bool = False) -> list[ArtefactResult]:
               f"last p-version H1 rate {r_p:.3f} (w.r.t. p). Our p-version BE errors are "
               "smaller than the published ones for p >= 2 (ratio down to ~0.7 in H1, ~0.2 "
               "in L2 at p = 7) although the FE errors of the same runs equal Table 2.4 to "
-              "the printed digits; the thesis's BE values probably carry a near-boundary "
-              "quadrature error of the representation formula that grows with p. Our rate "
-              "lies between the 5/6 of Theorem 2.2.3 and the 4/3 of the p-BEM."),
+              "the printed digits. Our H1 values equal the Q_p interpolation error of the "
+              "exact u to 0.1 % for p >= 3, and the published ones lie 1.09-1.38x above "
+              "that interpolation error, so no interpolant of the discrete solution can "
+              "give them; 18 other BE error measures were tried (boundary norms, other "
+              "interpolants, restricted domains, fixed quadrature of the representation "
+              "formula) and none reproduces the p-version rows without breaking Table 2.1 "
+              "or the h-version: the cause is unknown. Our rate lies between the 5/6 of "
+              "Theorem 2.2.3 and the 4/3 of the p-BEM."),
         Claim("p-version: better energy rate, worse L2 rate than the h-version in Omega2 "
               "(0.8 vs 0.66, 1.19 vs 1.4)", bool(r_p > r_h and l2_p < l2_h),
               f"energy {r_p:.3f} vs {r_h:.3f}, L2 {l2_p:.3f} vs {l2_h:.3f}"),
