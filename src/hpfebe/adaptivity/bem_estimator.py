@@ -135,19 +135,26 @@ def bem_indicators(op, U, Psi, tractions: dict, nq: int | None = None,
     ``f(x, n)`` or ``f(x, n, elem, t)`` (points also given as element index and reference
     coordinate in (-1, 1)): t_hat on "N", P_n n + P_t t on "C".  Elements with other labels (e.g.
     Gamma_D) get only the consistency term h_I ||d/ds (V Psi - (K + 1/2) U)||^2."""
-    mesh = op.mesh
-    r = boundary_residuals(op, U, Psi, nq)
+    return _indicators(op.mesh, boundary_residuals(op, U, Psi, nq), tractions, 1,
+                       return_parts)
+
+
+def _indicators(mesh, r, tractions: dict, d: int, return_parts: bool):
+    """h_I ||dres||^2_I + h_I ||t_hat - S_hat U||^2_I on the labelled elements, summed per
+    element from the residuals ``r`` at quadrature points (d components)."""
     h = mesh.lengths
     ne = mesh.n_elements
-    cons = h * np.bincount(r["elem"], r["w"] * r["dres"] ** 2, minlength=ne)
+    dres = np.asarray(r["dres"]).reshape(len(r["elem"]), d)
+    SU = np.asarray(r["SU"]).reshape(len(r["elem"]), d)
+    cons = h * np.bincount(r["elem"], r["w"] * np.sum(dres ** 2, 1), minlength=ne)
     trac = np.zeros(ne)
     for label, f in tractions.items():
         on = mesh.labels[r["elem"]] == label
         if not np.any(on):
             continue
         data = np.asarray(_call_datum(f, r["x"][on], r["n"][on], r["elem"][on], r["t"][on]),
-                          dtype=float)
-        trac += h * np.bincount(r["elem"][on], r["w"][on] * (data - r["SU"][on]) ** 2,
+                          dtype=float).reshape(-1, d)
+        trac += h * np.bincount(r["elem"][on], r["w"][on] * np.sum((data - SU[on]) ** 2, 1),
                                 minlength=ne)
     eta = np.sqrt(cons + trac)
     if return_parts:
@@ -233,34 +240,16 @@ def lame_bem_indicators(op, U, Psi, tractions: dict, nq: int | None = None,
     """eta_h(I) of (3.107) for Lame (vector residuals, Euclidean norm); ``tractions`` maps
     labels to callables (x, n) -> (n, 2) or (x, n, elem, t) -> (n, 2) (t_hat on "N",
     P_n n + P_t t on "C", see :func:`bem_indicators`)."""
-    mesh = op.mesh
-    r = lame_boundary_residuals(op, U, Psi, nq, delta)
-    h = mesh.lengths
-    ne = mesh.n_elements
-    cons = h * np.bincount(r["elem"], r["w"] * np.sum(r["dres"] ** 2, 1), minlength=ne)
-    trac = np.zeros(ne)
-    for label, f in tractions.items():
-        on = mesh.labels[r["elem"]] == label
-        if not np.any(on):
-            continue
-        data = np.asarray(_call_datum(f, r["x"][on], r["n"][on], r["elem"][on], r["t"][on]),
-                          dtype=float).reshape(-1, 2)
-        trac += h * np.bincount(r["elem"][on],
-                                r["w"][on] * np.sum((data - r["SU"][on]) ** 2, 1),
-                                minlength=ne)
-    eta = np.sqrt(cons + trac)
-    if return_parts:
-        return eta, {"traction": np.sqrt(trac), "consistency": np.sqrt(cons)}
-    return eta
+    return _indicators(op.mesh, lame_boundary_residuals(op, U, Psi, nq, delta), tractions,
+                       2, return_parts)
 
 
 def error_measure_B_lame(op, U, Psi, u_exact, traction_exact, extra: int = 3) -> float:
     """|||u - U|||_B (3.105) for Lame: (<W e_u, e_u> + <V e_psi, e_psi>)^(1/2) on the
     space of degree p_I + ``extra`` (exact u interpolated, exact traction projected per
     component; the discrete U, Psi embed exactly)."""
-    from ..analysis.norms import _project_W
+    from ..analysis.norms import _project_W, interpolation_difference
     from ..bem.lame import LameBEM
-    from ..quadrature import gauss_lobatto
 
     hi = LameBEM(op.mesh.with_degrees(op.mesh.degrees + extra), op.E, op.nu, op.plane,
                  scale=op.scale, zero_force=op.zero_force)
@@ -272,17 +261,6 @@ def error_measure_B_lame(op, U, Psi, u_exact, traction_exact, extra: int = 3) ->
     ep[hi_d[:, :lo_d.shape[1]][mask]] -= np.asarray(Psi).reshape(-1, 2)[lo_d[mask]]
     ep = ep.ravel()
     # displacement
-    eu = np.zeros((hi.V_space.ndof, 2))
-    mesh = hi.mesh
-    Ul = np.asarray(U).reshape(-1, 2)
-    for p in np.unique(mesh.degrees):
-        p = int(p)
-        els = np.flatnonzero(mesh.degrees == p)
-        xl, _ = gauss_lobatto(p + 1)
-        elem = np.repeat(els, p + 1)
-        t = np.tile(xl, len(els))
-        vals = np.asarray(u_exact(mesh.points(elem, t)), dtype=float) \
-            - op.V_space.evaluate(Ul, elem, t)
-        eu[hi.V_space.elem_dofs[els, :p + 1].ravel()] = vals
-    eu = eu.ravel()
+    eu = interpolation_difference(op.V_space, hi.V_space, np.asarray(U).reshape(-1, 2),
+                                  lambda x, n: u_exact(x)).ravel()
     return float(np.sqrt(max(eu @ hi.W @ eu, 0.0) + max(ep @ hi.V @ ep, 0.0)))

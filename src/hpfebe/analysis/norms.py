@@ -93,25 +93,32 @@ def energy_error_neumann(op, psi_h, flux, extra: int = 4) -> float:
     return float(np.sqrt(max(e @ hi.V @ e, 0.0)))
 
 
-def energy_error_dirichlet(op, u_h, u, extra: int = 4) -> float:
-    """|u - u_h|_W: u interpolated at degree p_I + extra, u_h embedded by evaluating it
-    at the richer Gauss-Lobatto points (exact: polynomials of lower degree)."""
-    hi = _richer(op, extra)
+def interpolation_difference(lo_space, hi_space, u_h, u) -> np.ndarray:
+    """Coefficients in ``hi_space`` (V_hp of higher degrees on the same mesh) of
+    I_hi u - u_h: u(x, n) is interpolated at the richer Gauss-Lobatto points and u_h
+    (coefficients in ``lo_space``, shape (ndof,) or (ndof, d)) is embedded by evaluation
+    there, which is exact since the spaces are nested."""
     from ..quadrature import gauss_lobatto
 
-    e = np.zeros(hi.V_space.ndof)
-    mesh = hi.mesh
+    u_h = np.asarray(u_h, dtype=float)
+    e = np.zeros((hi_space.ndof,) + u_h.shape[1:])
+    mesh = hi_space.mesh
     for p in np.unique(mesh.degrees):
         p = int(p)
         els = np.flatnonzero(mesh.degrees == p)
         xl, _ = gauss_lobatto(p + 1)
         elem = np.repeat(els, p + 1)
         t = np.tile(xl, len(els))
-        x = mesh.points(elem, t)
-        n = mesh.normals[elem]
-        vals = np.asarray(u(x, n), dtype=float) - op.V_space.evaluate(u_h, elem, t)
-        d = hi.V_space.elem_dofs[els, :p + 1].ravel()
-        e[d] = vals
+        vals = (np.asarray(u(mesh.points(elem, t), mesh.normals[elem]), dtype=float)
+                - lo_space.evaluate(u_h, elem, t))
+        e[hi_space.elem_dofs[els, :p + 1].ravel()] = vals
+    return e
+
+
+def energy_error_dirichlet(op, u_h, u, extra: int = 4) -> float:
+    """|u - u_h|_W: u interpolated at degree p_I + extra, u_h embedded exactly."""
+    hi = _richer(op, extra)
+    e = interpolation_difference(op.V_space, hi.V_space, u_h, u)
     return float(np.sqrt(max(e @ hi.W @ e, 0.0)))
 
 
