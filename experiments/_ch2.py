@@ -14,7 +14,7 @@ import numpy as np
 import pandas as pd
 
 from hpfebe.coupling import NitscheFEBE, problem
-from hpfebe.coupling.errors import be_domain_errors, fe_errors
+from hpfebe.coupling.errors import be_domain_errors, be_trace_energy_error, fe_errors
 from hpfebe.results import progress
 
 log = logging.getLogger("experiments.ch2")
@@ -38,10 +38,14 @@ def sweep(name: str, series: str, cases, lambdas, alpha: float, h_def: str,
             t_solve = time.perf_counter() - t1
             fe = fe_errors(model, sol)
             be = be_domain_errors(model, sol)
+            be_energy = be_trace_energy_error(model, sol)
+            be_interp = be_domain_errors(model, sol, interpolate_exact=True)["h1"]
             rows.append(dict(problem=name, series=series, lam=float(lam), p=int(p),
                              fe_h_inv=fh, be_h_inv=bh, n_fe=model.n1, n_be=model.n2,
                              dof=model.ndof, fe_l2=fe["l2"], fe_h1=fe["h1"],
-                             be_l2=be["l2"], be_h1=be["h1"], assembly_s=t_asm,
+                             be_l2=be["l2"], be_h1=be["h1"], be_energy=be_energy,
+                             be_h1_interp=be_interp,
+                             assembly_s=t_asm,
                              solve_s=t_solve, wall_time_s=t_asm + t_solve,
                              residual=sol.info["residual"]))
             log.info("%s %s p=%d FE 1/%g BE 1/%g lam=%g dof=%d: FE %.3e %.3e BE %.3e %.3e "
@@ -60,7 +64,9 @@ def rates(x, e) -> np.ndarray:
 
 def part_table(df: pd.DataFrame, part: str, h_col: str) -> pd.DataFrame:
     """Published-format table of one part ("fe" or "be"): series, h_inv, p, errors and
-    rates (w.r.t. h^-1 for series h, w.r.t. p for series p), then dof and timings."""
+    rates (w.r.t. h^-1 for series h, w.r.t. p for series p), then dof and timings; the BE
+    part adds the H1 error of the same interpolant of the exact u, and the trace energy
+    error |u - U2|_W on Gamma2 with its rate."""
     out = []
     for series, g in df.groupby("series", sort=False):
         keys = ["p"] if series == "h" else [h_col]
@@ -74,6 +80,10 @@ def part_table(df: pd.DataFrame, part: str, h_col: str) -> pd.DataFrame:
                 "dof": gg["dof"], "wall_time_s": gg["wall_time_s"],
                 "fe_h_inv": gg["fe_h_inv"], "be_h_inv": gg["be_h_inv"],
                 "lambda_nit": gg["lam"]})
+            if part == "be":
+                t["h1_interp_exact"] = gg["be_h1_interp"].to_numpy()
+                t["trace_energy_error"] = gg["be_energy"].to_numpy()
+                t["trace_energy_rate"] = rates(x, gg["be_energy"])
             out.append(t)
     return pd.concat(out, ignore_index=True)
 

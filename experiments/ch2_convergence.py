@@ -24,6 +24,8 @@ Choices where the thesis is silent (each checked against the printed numbers):
   interpolant, on a mesh of Omega2 of the BE mesh size, of the representation-formula
   solution (nodal values U2 on dOmega2): the measure that reproduces Table 2.1 and the
   h-version of Table 2.3 (hpfebe.coupling.errors explains why other measures do not).
+  BE tables add the H1 error of the same interpolant of the exact u and the trace energy
+  error |u - U2|_W on Gamma2 with its rate (the BE part of the norm of Theorem 2.2.3).
 * Rates: log(e_prev/e)/log(h_prev/h); for the p-series log(e_prev/e)/log(p/p_prev).
 * DOF = FE + BE unknowns without Gamma_D.
 """
@@ -109,6 +111,8 @@ def _convergence_figure(h, pv, xlabel_h, title, slopes):
             for norm, nm in (("h1", "energy-err"), ("l2", "L2-error")):
                 ax.loglog(df.dof, df[f"{part}_{norm}"], mk, ms=4,
                           label=f"{tag}: {nm} ({part.upper()})")
+        ax.loglog(df.dof, df.be_energy, mk, ms=3, alpha=0.6,
+                  label=f"{tag}: trace energy |u-U2|_W (BE)")
     for s, y0, lab in slopes:
         add_slope(ax, h.dof, y0, s, lab)
     ax.set_xlabel("DOF")
@@ -117,6 +121,32 @@ def _convergence_figure(h, pv, xlabel_h, title, slopes):
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=6, ncol=2)
     return fig
+
+
+def _p_version_evidence(t23: pd.DataFrame, r_p: float) -> str:
+    """Why the p-version energy rate of Table 2.3 is not reproduced (numbers of this run)."""
+    tp = t23[t23.series == "p"].sort_values("p")
+    th = t23[t23.series == "h"].sort_values("h_inv")
+    pub = _published("table_2_3_nitsche_singular_BE.csv")
+    pub = pub[pub.series == "p"].set_index("p")
+    hi = tp[tp.p >= 2].set_index("p")
+    ratio = pub.loc[hi.index, "h1_error"] / hi["h1_error"]
+    interp = (tp.h1_error / tp.h1_interp_exact - 1.0).abs()[tp.p >= 3]
+    return (
+        f"last p-version H1 rate {r_p:.3f} (w.r.t. p). The H1 error in Omega2 is the "
+        "interpolation error of the r^(2/3) corner on the fixed post-processing mesh: it "
+        "equals the error of the same Q_p interpolant of the exact u to "
+        f"{100 * interp.max():.1f} % for p >= 3. The published H1 errors lie "
+        f"{ratio.min():.2f}-{ratio.max():.2f}x above ours for p >= 2, although the FE "
+        "errors of the same runs equal Table 2.4 to the printed digits and the same "
+        "measure reproduces Table 2.1 and the h-version here; we found no post-processing "
+        "that gives them. The BE solution itself converges much faster: its trace energy "
+        "error |u - U2|_W (the BE part of the norm of Theorem 2.2.3) has the rate "
+        f"{tp.trace_energy_rate.iloc[-1]:.2f} in p (h-version: "
+        f"{th.trace_energy_rate.iloc[-1]:.2f} in h), because u = 0 on both Gamma_D sides "
+        "of the corner: the trace is smooth. So the printed 0.8 (and the 2/3 of the "
+        "h-version) measure the resolution of r^(2/3) by the post-processing mesh, not the "
+        "5/6 of Theorem 2.2.3.")
 
 
 def run(config: dict, quick: bool = False) -> list[ArtefactResult]:
@@ -157,7 +187,8 @@ def run(config: dict, quick: bool = False) -> list[ArtefactResult]:
     meta = dict(jit_s=round(jit_s, 2), smooth_s=round(t_smooth, 2),
                 singular_s=round(t_singular, 2), run_s=round(time.perf_counter() - t_all, 2),
                 lambda_nit=lam, alpha=alpha, h_def=h_def)
-    tmeta = dict(meta, allow_nan_columns=["l2_rate", "h1_rate"])
+    tmeta = {"FE": dict(meta, allow_nan_columns=["l2_rate", "h1_rate"]),
+             "BE": dict(meta, allow_nan_columns=["l2_rate", "h1_rate", "trace_energy_rate"])}
     common_notes = (
         f"lambda_Nit = {lam}, alpha = {alpha:g}, h1 = {h_def} length of the FE element on "
         "Gamma_I. BE part: domain errors in Omega2 of the Q_p equidistant interpolant (BE "
@@ -191,7 +222,7 @@ def run(config: dict, quick: bool = False) -> list[ArtefactResult]:
                      f"{len(ratio)} entries"))
         results.append(ArtefactResult(
             name=name, table=table, published=pubf, keys=("series", "h_inv", "p"),
-            tolerances=TOL, claims=claims, meta=tmeta,
+            tolerances=TOL, claims=claims, meta=tmeta[part],
             notes=common_notes + " Rates on the thesis's non-nested sequence (h^-1 = 2, 5, "
             "11, 23, 47) scatter, as in the thesis. The first rate of each sweep is NaN "
             "(no previous mesh)."))
@@ -207,18 +238,7 @@ def run(config: dict, quick: bool = False) -> list[ArtefactResult]:
         Claim("BE energy rate of the h-version ~0.66 (theory 2/3)", abs(r_h - 2 / 3) <= 0.08,
               f"last h-version H1 rate {r_h:.3f}"),
         Claim("BE energy rate of the p-version ~0.8 (theory 4/3 - 1/2 = 5/6)",
-              bool(abs(r_p - 0.8) <= 0.1),
-              f"last p-version H1 rate {r_p:.3f} (w.r.t. p). Our p-version BE errors are "
-              "smaller than the published ones for p >= 2 (ratio down to ~0.7 in H1, ~0.2 "
-              "in L2 at p = 7) although the FE errors of the same runs equal Table 2.4 to "
-              "the printed digits. Our H1 values equal the Q_p interpolation error of the "
-              "exact u to 0.1 % for p >= 3, and the published ones lie 1.09-1.38x above "
-              "that interpolation error, so no interpolant of the discrete solution can "
-              "give them; 18 other BE error measures were tried (boundary norms, other "
-              "interpolants, restricted domains, fixed quadrature of the representation "
-              "formula) and none reproduces the p-version rows without breaking Table 2.1 "
-              "or the h-version: the cause is unknown. Our rate lies between the 5/6 of "
-              "Theorem 2.2.3 and the 4/3 of the p-BEM."),
+              bool(abs(r_p - 0.8) <= 0.1), _p_version_evidence(t23, r_p)),
         Claim("p-version: better energy rate, worse L2 rate than the h-version in Omega2 "
               "(0.8 vs 0.66, 1.19 vs 1.4)", bool(r_p > r_h and l2_p < l2_h),
               f"energy {r_p:.3f} vs {r_h:.3f}, L2 {l2_p:.3f} vs {l2_h:.3f}"),
@@ -234,9 +254,9 @@ def run(config: dict, quick: bool = False) -> list[ArtefactResult]:
               f"{int(sg_p.dof.max())} DOF vs h-version {_last(t24, 'h', 1, 'h1_error'):.3e} "
               f"with {int(sg_h.dof.max())} DOF"),
     ]
-    for name, table, pubf, claims in (
-            ("table_2_3", t23, "table_2_3_nitsche_singular_BE.csv", claims23),
-            ("table_2_4", t24, "table_2_4_nitsche_singular_FE.csv", claims24)):
+    for name, table, pubf, part, claims in (
+            ("table_2_3", t23, "table_2_3_nitsche_singular_BE.csv", "BE", claims23),
+            ("table_2_4", t24, "table_2_4_nitsche_singular_FE.csv", "FE", claims24)):
         pub = _published(pubf)
         ratio = pd.concat([compare(table, pub, "l2_error"), compare(table, pub, "h1_error")])
         claims = list(claims) + [Claim(
@@ -247,7 +267,7 @@ def run(config: dict, quick: bool = False) -> list[ArtefactResult]:
             c.holds = bool(c.holds)
         results.append(ArtefactResult(
             name=name, table=table, published=pubf, keys=("series", "h_inv", "p"),
-            tolerances=TOL_SINGULAR, claims=claims, meta=tmeta,
+            tolerances=TOL_SINGULAR, claims=claims, meta=tmeta[part],
             notes=common_notes + " p-version on FE h^-1 = 4, BE h^-1 = 6 (table headers; "
             "the caption of Figure 2.4 says 1/6, 1/8). BE p-version rows for p >= 2 differ "
             "from the thesis (see the claim); the FE rows are exact."))
@@ -300,9 +320,7 @@ def run(config: dict, quick: bool = False) -> list[ArtefactResult]:
     axs = fig.subplots(1, 2)
     for ax, name in zip(axs, ("smooth", "singular")):
         d = wp[wp.problem == name]
-        for (series, p), g in d.groupby(["series", "p"] if True else []):
-            if series == "p":
-                continue
+        for p, g in d[d.series == "h"].groupby("p"):
             ax.loglog(g.wall_time_s, g.fe_h1 + g.be_h1, "o-", ms=3, label=f"h-version p={p}")
         g = d[d.series == "p"]
         ax.loglog(g.wall_time_s, g.fe_h1 + g.be_h1, "s--", ms=3, label="p-version")

@@ -32,6 +32,7 @@ class InterfaceProblem:
     """An FE/BE interface problem (2.2) with known solution.
 
     ``u(x, y)``, ``grad_u(x, y) -> (ux, uy)`` and ``f(x, y)`` (None: f = 0) are vectorised.
+    ``singular_points``: where grad u is unbounded (error integrals are graded there).
     """
 
     name: str
@@ -45,6 +46,7 @@ class InterfaceProblem:
     fe_label: Callable
     be_vertices: tuple
     be_labels: tuple
+    singular_points: tuple = ()
 
     def fe_domain(self, h_inv: float) -> FEDomain:
         """FE mesh of Omega1 with cells of size <= 1/h_inv (module doc)."""
@@ -149,6 +151,7 @@ SINGULAR = InterfaceProblem(
     in_omega1=_in_omega1_singular, in_omega2=_in_omega2_singular, fe_label=_label_singular,
     be_vertices=((0.0, 0.0), (0.5, 0.0), (0.5, 0.5), (-0.5, 0.5), (-0.5, -0.5), (0.0, -0.5)),
     be_labels=("D", "I", "I", "I", "I", "D"),
+    singular_points=((0.0, 0.0),),
 )
 
 PROBLEMS = {"smooth": SMOOTH, "singular": SINGULAR}
