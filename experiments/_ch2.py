@@ -24,8 +24,10 @@ PUBLISHED_COLUMNS = ["series", "h_inv", "p", "l2_error", "l2_rate", "h1_error", 
 
 
 def sweep(name: str, series: str, cases, lambdas, alpha: float, h_def: str,
-          desc: str = "") -> pd.DataFrame:
-    """One row per (case, lambda): cases are (fe_h_inv, be_h_inv, p) triples."""
+          desc: str = "", companions: bool = False) -> pd.DataFrame:
+    """One row per (case, lambda): cases are (fe_h_inv, be_h_inv, p) triples.
+    ``companions`` adds the BE columns be_energy (|u - U2|_W, which assembles a richer
+    W per solve) and be_h1_interp (the interpolation error of the exact u)."""
     pb = problem(name)
     rows = []
     for fh, bh, p in progress(list(cases), desc=desc or f"{name} {series}"):
@@ -38,16 +40,17 @@ def sweep(name: str, series: str, cases, lambdas, alpha: float, h_def: str,
             t_solve = time.perf_counter() - t1
             fe = fe_errors(model, sol)
             be = be_domain_errors(model, sol)
-            be_energy = be_trace_energy_error(model, sol)
-            be_interp = be_domain_errors(model, sol, interpolate_exact=True)["h1"]
-            rows.append(dict(problem=name, series=series, lam=float(lam), p=int(p),
-                             fe_h_inv=fh, be_h_inv=bh, n_fe=model.n1, n_be=model.n2,
-                             dof=model.ndof, fe_l2=fe["l2"], fe_h1=fe["h1"],
-                             be_l2=be["l2"], be_h1=be["h1"], be_energy=be_energy,
-                             be_h1_interp=be_interp,
-                             assembly_s=t_asm,
-                             solve_s=t_solve, wall_time_s=t_asm + t_solve,
-                             residual=sol.info["residual"]))
+            row = dict(problem=name, series=series, lam=float(lam), p=int(p),
+                       fe_h_inv=fh, be_h_inv=bh, n_fe=model.n1, n_be=model.n2,
+                       dof=model.ndof, fe_l2=fe["l2"], fe_h1=fe["h1"],
+                       be_l2=be["l2"], be_h1=be["h1"], assembly_s=t_asm,
+                       solve_s=t_solve, wall_time_s=t_asm + t_solve,
+                       residual=sol.info["residual"])
+            if companions:
+                row["be_energy"] = be_trace_energy_error(model, sol)
+                row["be_h1_interp"] = be_domain_errors(model, sol,
+                                                       interpolate_exact=True)["h1"]
+            rows.append(row)
             log.info("%s %s p=%d FE 1/%g BE 1/%g lam=%g dof=%d: FE %.3e %.3e BE %.3e %.3e "
                      "(%.2f s + %.2f s)", name, series, p, fh, bh, lam, model.ndof,
                      fe["l2"], fe["h1"], be["l2"], be["h1"], t_asm, t_solve)
@@ -80,7 +83,7 @@ def part_table(df: pd.DataFrame, part: str, h_col: str) -> pd.DataFrame:
                 "dof": gg["dof"], "wall_time_s": gg["wall_time_s"],
                 "fe_h_inv": gg["fe_h_inv"], "be_h_inv": gg["be_h_inv"],
                 "lambda_nit": gg["lam"]})
-            if part == "be":
+            if part == "be" and "be_energy" in gg:
                 t["h1_interp_exact"] = gg["be_h1_interp"].to_numpy()
                 t["trace_energy_error"] = gg["be_energy"].to_numpy()
                 t["trace_energy_rate"] = rates(x, gg["be_energy"])
