@@ -15,7 +15,8 @@ import pytest
 from hpfebe import BoundaryMesh
 from hpfebe.bem.lame import LameBEM
 from hpfebe.contact import solve_penalty
-from hpfebe.contact.friction import SLIP, STICK, _FrictionTerm, solve_friction
+from hpfebe.contact import BEBody, RigidObstacle, TwoBodyContact
+from hpfebe.contact.friction import SLIP, STICK, solve_friction
 from hpfebe.quadrature import gauss_legendre
 from hpfebe.spaces import lagrange_values
 
@@ -169,28 +170,26 @@ def test_newton_converges_quadratically(body):
 def test_linearisation_is_consistent(body):
     """Finite differences of the residual along random directions reproduce the Newton
     matrix (Coulomb: stick, slip with the d p_n/dU coupling, open points)."""
-    mesh = body.mesh
-    term = _FrictionTerm(body, np.flatnonzero(mesh.where("C")))
+    gap = lambda p: -D + 3e-4 * (p[:, 0] + 1)            # tilted obstacle: open points
+    motion = lambda p: 2e-4 * (1 + p[:, 0])
     rng = np.random.default_rng(0)
-    x = term.points[:, 0]
-    res = solve_friction(body, EPS_N, EPS_T, lambda p: -D + 3e-4 * (p[:, 0] + 1),
-                         friction="coulomb", mu_f=MU,
-                         obstacle_slip=lambda p: 2e-4 * (1 + p[:, 0]))
+    res = solve_friction(body, EPS_N, EPS_T, gap, friction="coulomb", mu_f=MU,
+                         obstacle_slip=motion)
     assert res.converged, res.reason
     U = res.U
-    g = -D + 3e-4 * (x + 1)                               # tilted obstacle: open points
-    kw = dict(law="coulomb", eps_n=EPS_N, eps_t=EPS_T, g=g, w=2e-4 * (1 + x), gp=0 * g,
-              F=None, mu=MU)
-    st = term.evaluate(U, **kw)
+    pr = TwoBodyContact(BEBody(body), RigidObstacle(gap, motion), "C", eps_n=EPS_N,
+                        eps_t=EPS_T, mu_f=MU, nq=None)
+    slip = np.zeros(len(pr.points))
+    st = pr.contact_state(U, slip)
     assert np.allclose(st["t_t"], res.t_t, rtol=0, atol=1e-12 * np.abs(res.t_t).max())
     states = set(st["state"].tolist())
     assert states == {0, 1, 2}, states
-    J = term.jacobian(st)
+    J = pr.tangent(st)
     for _ in range(3):
         v = rng.standard_normal(len(U)) * np.abs(U).max()
         h = 1e-6
-        Fp = term.force(term.evaluate(U + h * v, **kw))
-        Fm = term.force(term.evaluate(U - h * v, **kw))
+        Fp = pr.internal_force(U + h * v, slip)[0]
+        Fm = pr.internal_force(U - h * v, slip)[0]
         fd = (Fp - Fm) / (2 * h)
         assert np.abs(fd - J @ v).max() <= 1e-6 * np.abs(J @ v).max()
     assert not np.allclose(J, J.T)                        # Coulomb: non-symmetric

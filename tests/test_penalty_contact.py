@@ -2,13 +2,15 @@
 
 from __future__ import annotations
 
+import json
+
 import numpy as np
 import pytest
 
 from hpfebe import BoundaryMesh
 from hpfebe.bem.lame import LameBEM
 from hpfebe.contact import solve_penalty
-from hpfebe.contact.penalty import _ContactTerm
+from hpfebe.contact.penalty import penalty_terms
 from hpfebe.quadrature import gauss_legendre, gauss_lobatto
 from hpfebe.spaces import lagrange_values
 
@@ -93,13 +95,11 @@ def test_positive_part_integration_exact():
                                 labels=["C", "N", "D", "N"])
     bem = LameBEM(mesh, E, NU)
     xg, _ = gauss_lobatto(4)
-    gn = np.zeros(4)
-    term = _ContactTerm(bem, np.array([0]), [gn])
     U = np.zeros(2 * bem.V_space.ndof)
     wn = np.array([0.3, -0.5, 0.4, -0.2])    # nodal values of U_n on element 0 (n = (0,-1))
     d = bem.V_space.elem_dofs[0, :4]
     U[2 * d + 1] = -wn
-    energy, F, J, nact = term.assemble(U)
+    energy, F, nact = penalty_terms(bem, U, 0.0)
     # reference: roots from a Legendre fit (numpy.polynomial.legendre), 12-point Gauss on
     # each piece where w > 0
     from numpy.polynomial import legendre as L
@@ -156,23 +156,26 @@ def test_bad_inputs(body8):
         solve_penalty(body8, 1e-5, -D, max_iter=0)
 
 
-def test_table_3_1_reproduced_on_coarse_meshes():
+def test_table_3_1_reproduced_on_coarse_meshes(tmp_path):
     """Regression guard for experiments/ch3_penalty.py on n = 4, 8, 16, 32: with plane
     strain and the sqrt(2) norm scale (see the module doc) the published err(U) of
     Table 3.1 is matched; S_hat once per mesh, one Newton step per run."""
-    import importlib.util
+    import subprocess
+    import sys
     from pathlib import Path
 
     import pandas as pd
+    import yaml
 
     root = Path(__file__).resolve().parents[1]
-    spec = importlib.util.spec_from_file_location("ch3_penalty",
-                                                  root / "experiments" / "ch3_penalty.py")
-    mod = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(mod)
-    res = mod.run({"n_per_side": [4, 8, 16, 32], "fixed_eps": []}, quick=True)
-    table = res[0].table
-    assert res[0].meta["plane_reported"] == "strain"
+    cfg = tmp_path / "c.yaml"
+    cfg.write_text(yaml.safe_dump({"ch3_penalty": {"n_per_side": [4, 8, 16, 32],
+                                                   "fixed_eps": []}}))
+    subprocess.run([sys.executable, "-m", "hpfebe", "run", "table_3_1", "--quick",
+                    "--config", str(cfg), "--out", str(tmp_path)], check=True, cwd=root)
+    table = pd.read_csv(tmp_path / "table_3_1.csv")
+    meta = json.loads((tmp_path / "table_3_1.json").read_text())["meta"]
+    assert meta["plane_reported"] == "strain"
     pub = pd.read_csv(root / "report" / "published" / "table_3_1_penalty_eps.csv",
                       comment="#")
     m = pub.merge(table, on=["C_eps", "dof"], suffixes=("_pub", ""))

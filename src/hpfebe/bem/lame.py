@@ -65,46 +65,32 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..geometry import BoundaryMesh
+from ..materials import PLANES, lame_constants, linear_stress  # noqa: F401  (re-exported)
 from ..spaces import ContinuousSpace, DiscontinuousSpace
 from .assembly import assemble, local_block, sandwich
-from .kernels import LAME_DL, LAME_HS, LAME_SL
+from .kernels import (KP_C1, KP_C1_C2, KP_C1_LOG_R, KP_C2, KP_ET, KP_ET_LOG_R, KP_LAMBDA,
+                      KP_LAME_SIZE, KP_MU, LAME_DL, LAME_HS, LAME_SL)
 from .operators import BoundaryOperators
 from .potentials import (POT_LAME_DL, POT_LAME_DL_GRAD, POT_LAME_SL, POT_LAME_SL_GRAD,
                          evaluate_potential)
 
-PLANES = ("strain", "stress")
-
-
 # The Lame kernels (regular parts) live in kernels.py as LAME_SL, LAME_DL, LAME_HS: the
-# assemblers take kernel ids.  kp layout (kernel_params):
-# [c1 log R, c1 c2, lambda, mu, c1, c2, Et log R, Et], Et = E'/(4 pi).
-
-
-def lame_constants(E: float, nu: float, plane: str = "strain") -> tuple[float, float]:
-    """(lambda, mu) of the 2D model: plane strain, or plane stress with
-    lambda* = 2 lambda mu / (lambda + 2 mu)."""
-    E = float(E)
-    nu = float(nu)
-    if not (math.isfinite(E) and E > 0):
-        raise ValueError(f"E (Young's modulus) must be positive, got {E!r}")
-    if not (math.isfinite(nu) and -1.0 < nu < 0.5):
-        raise ValueError(f"nu (Poisson ratio) must lie in (-1, 0.5), got {nu!r}")
-    if plane not in PLANES:
-        raise ValueError(f"plane must be one of {PLANES}, got {plane!r}")
-    lam = E * nu / ((1.0 + nu) * (1.0 - 2.0 * nu))
-    mu = E / (2.0 * (1.0 + nu))
-    if plane == "stress":
-        lam = 2.0 * lam * mu / (lam + 2.0 * mu)
-    return lam, mu
+# assemblers take kernel ids and the parameter array of kernel_params, read by the
+# named indices KP_* of kernels.py.
 
 
 def kernel_params(lam: float, mu: float, scale: float) -> np.ndarray:
-    """Parameter array kp shared by all Lame kernels (layout in the comment above)."""
+    """Parameter array kp shared by all Lame kernels (indices KP_* of
+    :mod:`hpfebe.bem.kernels`): c1 log R, c1 c2, lambda, mu, c1, c2, Et log R, Et with
+    Et = E'/(4 pi) and R = ``scale``."""
     c1 = (lam + 3.0 * mu) / (4.0 * math.pi * mu * (lam + 2.0 * mu))
     c2 = (lam + mu) / (lam + 3.0 * mu)
     Et = 4.0 * mu * (lam + mu) / (lam + 2.0 * mu) / (4.0 * math.pi)
     lR = math.log(scale)
-    return np.array([c1 * lR, c1 * c2, lam, mu, c1, c2, Et * lR, Et])
+    kp = np.empty(KP_LAME_SIZE)
+    kp[[KP_C1_LOG_R, KP_C1_C2, KP_LAMBDA, KP_MU, KP_C1, KP_C2, KP_ET_LOG_R, KP_ET]] = (
+        c1 * lR, c1 * c2, lam, mu, c1, c2, Et * lR, Et)
+    return kp
 
 
 def _logc(c: float) -> np.ndarray:
@@ -152,12 +138,12 @@ class LameBEM(BoundaryOperators):
 
     @property
     def c1(self) -> float:
-        return float(self.kp[4])
+        return float(self.kp[KP_C1])
 
     @property
     def Et(self) -> float:
         """E'/(4 pi), the factor of the integrated-by-parts hypersingular kernel."""
-        return float(self.kp[7])
+        return float(self.kp[KP_ET])
 
     # --------------------------------------------------------------- operators
     @property
@@ -239,8 +225,8 @@ class LameBEM(BoundaryOperators):
         """Stress sigma(u) = lambda tr eps I + 2 mu eps at interior points, (n, 2, 2)
         (lambda = lambda* in plane stress)."""
         g = self.displacement_gradient(points, U, psi)
-        div = g[:, 0, 0] + g[:, 1, 1]
-        return self.lam * div[:, None, None] * np.eye(2) + self.mu * (g + np.swapaxes(g, 1, 2))
+        eps = np.moveaxis(0.5 * (g + np.swapaxes(g, 1, 2)), 0, -1)   # (2, 2, n)
+        return np.moveaxis(linear_stress(eps, self.lam, self.mu), -1, 0)
 
 
 def local_blocks(mesh: BoundaryMesh, i: int, j: int, E: float, nu: float,
@@ -250,9 +236,9 @@ def local_blocks(mesh: BoundaryMesh, i: int, j: int, E: float, nu: float,
     W = T_i^T Vt_ij T_j (GLL^2 x GLL^2).  For tests."""
     lam, mu = lame_constants(E, nu, plane)
     kp = kernel_params(lam, mu, scale)
-    V = local_block(LAME_SL, _logc(kp[4]), kp, mesh, i, j, 0, 0, d=2)
+    V = local_block(LAME_SL, _logc(kp[KP_C1]), kp, mesh, i, j, 0, 0, d=2)
     K = local_block(LAME_DL, NO_LOG, kp, mesh, i, j, 0, 1, d=2)
-    Vt = local_block(LAME_HS, _logc(kp[7]), kp, mesh, i, j, 0, 0, d=2)
+    Vt = local_block(LAME_HS, _logc(kp[KP_ET]), kp, mesh, i, j, 0, 0, d=2)
     Ts = []
     for e in (i, j):
         p = int(mesh.degrees[e])

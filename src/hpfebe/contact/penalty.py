@@ -28,13 +28,15 @@ derivative exactly.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 import scipy.linalg as sla
 
+from ..nonlinear import Iterate, SingularStep, SolverInfo, newton
 from ..quadrature import gauss_legendre, gauss_lobatto
 from ..spaces import lagrange_values
+from .laws import positive
 
 
 @dataclass
@@ -47,7 +49,7 @@ class PenaltyResult:
         "line search failed")
     pressure : callable (elem, t) -> p_eps = (1/eps)(U_n - g_h)_+ >= 0 on contact
         elements (t in [-1, 1]); pressure_nodes : (x, p) at the GLL nodes of Gamma_C
-    active_history : number of contact elements in (partial) contact per iterate
+    info : the SolverInfo of the Newton iteration
     jacobian : only with ``solve_penalty(..., keep_jacobian=True)``: the Newton matrix
         S_hat + (1/eps) J_c(U) at the returned iterate, restricted to the free dofs
         (dense; e.g. for its condition number), else None
@@ -62,7 +64,7 @@ class PenaltyResult:
     pressure: object = None
     pressure_nodes: tuple = None
     energy: float = float("nan")
-    active_history: list = field(default_factory=list)
+    info: SolverInfo = None
     jacobian: np.ndarray | None = None
 
 
@@ -146,47 +148,8 @@ class _ContactTerm:
         return p_eps, (np.vstack(xs), np.concatenate(ps))
 
 
-def solve_penalty(bem, eps: float, gap, load=None, contact_label: str = "C",
-                  dirichlet_label: str = "D", S=None, max_iter: int = 50,
-                  tol: float = 1e-10, keep_jacobian: bool = False) -> PenaltyResult:
-    """Penalty contact (3.45)-(3.46) with S_hat, by semismooth Newton.
-
-    Parameters
-    ----------
-    bem : LameBEM of the body (its mesh carries the labels)
-    eps : penalty parameter > 0
-    gap : float or callable g(x) (x of shape (n, 2)) on Gamma_C, constraint U_n <= g
-    load : interleaved vector L(v) on V_hp^2 (tested Neumann data), default 0
-    S : S_hat to use (default ``bem.S_hat``; pass it to reuse one matrix for many eps)
-    max_iter, tol : Newton limit; stop when max|residual| <= tol * (force scale of the
-        current iterate: max of |L|, |S_hat U| and the contact forces |(1/eps) int
-        (U_n - g)_+ v_n|, free dofs).  (Not relative to the initial residual: that grows
-        like 1/eps and would accept wrong active sets for small eps.)
-    keep_jacobian : return the Newton matrix at the final iterate (free dofs) in
-        ``PenaltyResult.jacobian``
-
-    A gap that is never closed (g_h >= 0 on Gamma_C and no load pushing into the obstacle)
-    gives the zero-contact solution: zero pressure, reason "no contact" if U = 0 solves.
-    """
-    eps = float(eps)
-    if not (np.isfinite(eps) and eps > 0):
-        raise ValueError(f"eps (penalty parameter) must be positive, got {eps!r}")
-    if int(max_iter) < 1:
-        raise ValueError(f"max_iter must be >= 1, got {max_iter!r}")
-    mesh, Vs = bem.mesh, bem.V_space
-    celems = np.flatnonzero(mesh.where(contact_label))
-    if celems.size == 0:
-        raise ValueError(f"contact_label {contact_label!r}: no element carries this label")
-    S = bem.S_hat if S is None else S
-    ndof = 2 * Vs.ndof
-    f = np.zeros(ndof) if load is None else np.asarray(load, dtype=float)
-    if f.shape != (ndof,):
-        raise ValueError(f"load must have {ndof} entries, got {f.shape}")
-    fixed = np.zeros(ndof, dtype=bool)
-    D = Vs.dofs_on(dirichlet_label) if np.any(mesh.where(dirichlet_label)) else np.array([], int)
-    fixed[2 * D] = fixed[2 * D + 1] = True
-    free = np.flatnonzero(~fixed)
-    # gap interpolated at the GLL nodes of every contact element
+def _gap_nodes(mesh, celems, gap) -> list:
+    """The gap g at the GLL nodes of every contact element (its interpolant g_h)."""
     g_nodes = []
     for e in celems:
         p = int(mesh.degrees[e])
@@ -197,81 +160,111 @@ def solve_penalty(bem, eps: float, gap, load=None, contact_label: str = "C",
         if not np.all(np.isfinite(gv)):
             raise ValueError("gap must be finite on Gamma_C")
         g_nodes.append(gv)
-    term = _ContactTerm(bem, celems, g_nodes)
-    Sff = S[np.ix_(free, free)]
+    return g_nodes
 
-    def energy_grad(U, jac=True):
-        ec, Fc, Jc, nact = term.assemble(U, jac)
-        SU = S @ U
-        Jv = 0.5 * U @ SU + ec / eps - f @ U
-        G = SU + Fc / eps - f
-        # force scale of this iterate for the stopping test
-        fs = max(np.abs(f[free]).max(initial=0.0), np.abs(SU[free]).max(initial=0.0),
-                 np.abs(Fc[free]).max(initial=0.0) / eps, 1e-300)
-        return Jv, G, Jc, nact, fs
 
-    U = np.zeros(ndof)
-    Jv, G, Jc, nact, fs = energy_grad(U)
-    residuals = [float(np.abs(G[free]).max())]
-    energies = [float(Jv)]
-    active_hist = [nact]
-    seen = {}
-    reason, converged, it = "max_iter", False, 0
-    if residuals[0] == 0.0 or (nact == 0 and residuals[0] <= tol * fs):
-        reason, converged = ("no contact" if nact == 0 else "converged"), True
-    else:
-        for it in range(1, int(max_iter) + 1):
-            A = Sff + Jc[np.ix_(free, free)] / eps
-            try:
-                dU = -sla.solve(A, G[free], assume_a="sym")
-            except (np.linalg.LinAlgError, ValueError):
-                reason = "singular Newton matrix (body not fixed?)"
-                break
-            # for small eps the residual floor is cond(A) * macheps * (contact forces),
-            # above tol: stop when Newton cannot change U any more
-            if np.abs(dU).max() <= 64 * np.finfo(float).eps * np.abs(U[free]).max():
-                reason, converged = ("converged (Newton update at round-off level; the "
-                                     "residual is limited by the conditioning)"), True
-                break
-            # backtracking line search on the convex energy J
-            step, ok = 1.0, False
-            for _ in range(30):
-                Un = U.copy()
-                Un[free] += step * dU
-                Jn, Gn, Jcn, nactn, fsn = energy_grad(Un)
-                if Jn <= Jv + 1e-4 * step * (G[free] @ dU) + 1e-14 * abs(Jv):
-                    ok = True
-                    break
-                step *= 0.5
-            if not ok:
-                reason = "line search failed"
-                break
-            U, Jv, G, Jc, nact, fs = Un, Jn, Gn, Jcn, nactn, fsn
-            res = float(np.abs(G[free]).max())
-            residuals.append(res)
-            energies.append(float(Jv))
-            active_hist.append(nact)
-            if res <= tol * fs:
-                reason, converged = "converged", True
-                break
-            # cycling: an earlier nodal contact pattern returns and the energy (the merit
-            # the line search decreases) has not decreased since: no progress is possible.
-            # (The residual is no measure here: line-search steps may raise it.)
-            key = tuple(np.round(np.concatenate(
-                [np.sign(U[2 * d] * n[0] + U[2 * d + 1] * n[1] - gn)
-                 for e, p, d, n, idx, gn in term.items]), 0))
-            if key in seen and Jv >= energies[seen[key]] - 1e-14 * abs(Jv):
-                if step * np.abs(dU).max() <= 1e-8 * np.abs(U[free]).max():
-                    # tiny steps, no energy decrease: stagnation at round-off, not cycling
-                    reason, converged = ("converged (stagnation at round-off level; the "
-                                         "residual is limited by the conditioning)"), True
-                else:
-                    reason = (f"cycling: active set of iterate {seen[key]} repeated at {it} "
-                              "without energy decrease")
-                break
-            seen[key] = it
+class _PenaltyProblem:
+    """The Newton problem of (3.57)-(3.58) for :func:`hpfebe.nonlinear.newton`: residual
+    G = S_hat U + (1/eps) int (U_n - g_h)_+ v_n - L on the free dofs, merit the energy J,
+    force scale max(|L|, |S_hat U|, contact forces) of the iterate, and the nodal contact
+    pattern for cycling."""
+
+    def __init__(self, term, S, f, free, eps):
+        self.term, self.S, self.f, self.free, self.eps = term, S, f, free, eps
+        self.Sff = S[np.ix_(free, free)]
+
+    def evaluate(self, U):
+        free, eps = self.free, self.eps
+        ec, Fc, Jc, nact = self.term.assemble(U, True)
+        SU = self.S @ U
+        G = SU + Fc / eps - self.f
+        J = 0.5 * U @ SU + ec / eps - self.f @ U
+        scale = max(np.abs(self.f[free]).max(initial=0.0), np.abs(SU[free]).max(initial=0.0),
+                    np.abs(Fc[free]).max(initial=0.0) / eps, 1e-300)
+        key = np.signbit(np.concatenate([U[2 * d] * n[0] + U[2 * d + 1] * n[1] - gn
+                                         for e, p, d, n, idx, gn in self.term.items]))
+        return Iterate(U, G[free], float(J), scale, key.tobytes(), (Jc, nact))
+
+    def jacobian(self, it):
+        Jc = it.data[0]
+        return self.Sff + Jc[np.ix_(self.free, self.free)] / self.eps
+
+    def step(self, it):
+        try:
+            d = sla.solve(self.jacobian(it), -it.residual, assume_a="sym")
+        except (np.linalg.LinAlgError, ValueError):
+            raise SingularStep("singular Newton matrix (body not fixed?)") from None
+        dU = np.zeros_like(it.x)
+        dU[self.free] = d
+        return dU
+
+    def slope(self, it, dU):
+        return float(it.residual @ dU[self.free])
+
+
+def solve_penalty(bem, eps: float, gap, load=None, contact_label: str = "C",
+                  dirichlet_label: str = "D", S=None, max_iter: int = 50,
+                  tol: float = 1e-10, keep_jacobian: bool = False) -> PenaltyResult:
+    """Penalty contact (3.45)-(3.46) with S_hat, by semismooth Newton
+    (:func:`hpfebe.nonlinear.newton`: energy line search, round-off stop, cycling).
+
+    Parameters
+    ----------
+    bem : LameBEM of the body (its mesh carries the labels)
+    eps : penalty parameter > 0
+    gap : float or callable g(x) (x of shape (n, 2)) on Gamma_C, constraint U_n <= g
+    load : interleaved vector L(v) on V_hp^2, default 0
+    S : S_hat to use (default ``bem.S_hat``; pass it to reuse one matrix for many eps)
+    max_iter, tol : Newton limit; stop when max|residual| <= tol * (force scale of the
+        current iterate: max of |L|, |S_hat U| and the contact forces, free dofs; not
+        relative to the initial residual, which grows like 1/eps)
+    keep_jacobian : return the Newton matrix at the final iterate (free dofs)
+
+    A gap that is never closed gives the zero-contact solution (reason "no contact").
+    """
+    eps = positive("eps (penalty parameter)", eps)
+    if isinstance(max_iter, bool) or int(max_iter) < 1:
+        raise ValueError(f"max_iter must be >= 1, got {max_iter!r}")
+    mesh, Vs = bem.mesh, bem.V_space
+    celems = np.flatnonzero(mesh.where(contact_label))
+    if celems.size == 0:
+        raise ValueError(f"contact_label {contact_label!r}: no element carries this label")
+    S = bem.S_hat if S is None else S
+    ndof = 2 * Vs.ndof
+    f = np.zeros(ndof) if load is None else np.asarray(load, dtype=float)
+    if f.shape != (ndof,):
+        raise ValueError(f"load must have {ndof} entries, got {f.shape}")
+    labels = (dirichlet_label,) if np.any(mesh.where(dirichlet_label)) else ()
+    free = Vs.free_dofs(*labels, components=2) if labels else np.arange(ndof)
+    term = _ContactTerm(bem, celems, _gap_nodes(mesh, celems, gap))
+    problem = _PenaltyProblem(term, S, f, free, eps)
+    it, info = newton(problem, np.zeros(ndof), tol, int(max_iter), norm=np.inf,
+                      roundoff_stop=True)
+    U, (Jc, nact) = it.x, it.data
+    if info.converged and info.iterations == 0 and nact == 0:
+        info.reason = "no contact"
     p_fun, p_nodes = term.pressure(U, eps)
-    jac = (Sff + Jc[np.ix_(free, free)] / eps) if keep_jacobian else None
-    return PenaltyResult(U=U, iterations=it, residuals=residuals, converged=converged,
-                         reason=reason, eps=eps, pressure=p_fun, pressure_nodes=p_nodes,
-                         energy=float(Jv), active_history=active_hist, jacobian=jac)
+    return PenaltyResult(U=U, iterations=info.iterations, residuals=info.residuals,
+                         converged=info.converged, reason=info.reason, eps=eps,
+                         pressure=p_fun, pressure_nodes=p_nodes, energy=float(it.merit),
+                         info=info,
+                         jacobian=problem.jacobian(it) if keep_jacobian else None)
+
+
+def penalty_terms(bem, U, gap, contact_label: str = "C"):
+    """(int (U_n - g_h)_+^2 / 2, the vector int (U_n - g_h)_+ v_n over V_hp^2, the number
+    of contact elements in (partial) contact), integrated exactly (module doc)."""
+    mesh = bem.mesh
+    celems = np.flatnonzero(mesh.where(contact_label))
+    if celems.size == 0:
+        raise ValueError(f"contact_label {contact_label!r}: no element carries this label")
+    term = _ContactTerm(bem, celems, _gap_nodes(mesh, celems, gap))
+    energy, F, _, nact = term.assemble(np.asarray(U, dtype=float), with_jacobian=False)
+    return energy, F, nact
+
+
+def penalty_residual(bem, U, eps: float, gap, S=None, contact_label: str = "C") -> np.ndarray:
+    """S_hat U + (1/eps) int_{Gamma_C} (U_n - g_h)_+ v_n ds on all dofs: the equation
+    :func:`solve_penalty` solves (without the load) at a given U."""
+    S = bem.S_hat if S is None else S
+    return S @ U + penalty_terms(bem, U, gap, contact_label)[1] / eps

@@ -8,7 +8,7 @@ Bodies.  Each body is either a P1/Q1 finite element body
 (:class:`hpfebe.bem.lame.LameBEM` on a labelled :class:`hpfebe.geometry.BoundaryMesh`).
 The contact code below is written once; what depends on the discretisation (stiffness,
 contact segments, traces at the contact points, boundary conditions and loads) comes
-from a body adapter (:mod:`hpfebe.contact.bem_body`).  A BE body's unknowns are its
+from the body (:mod:`hpfebe.contact.bodies`).  A BE body's unknowns are its
 boundary displacement in V_hp^2 (interleaved components), its stiffness the dense
 discrete Steklov-Poincare operator S_hat, its traces the GLL Lagrange basis of degree p.
 
@@ -52,84 +52,51 @@ x_m = the projection and N_m the master shape functions at it,
     g_n = (x_s + u_s - x_m - u_m) . n_m     (signed normal gap; penetration  g_n < 0),
     g_t = (u_s - u_m) . t_m                 (relative tangential displacement).
 
-Constitutive laws (signs: p_n >= 0 is the contact pressure, the negative of the thesis's
-P_n in (4.19); t_t is the friction traction with the sign of the elastic slip, the
-negative of P_t in (4.20)):
+Laws: the normal penalty and the Coulomb / Tresca return map of
+:mod:`hpfebe.contact.laws` with penetration d_n = -g_n and slip g_t, the traction on the
+slave p_n n_m - t_t t_m, on the master its negative.  Weak form, with the internal contact
+force f_c(U) . V = sum_q w_q [ -p_n dg_n(V) + t_t dg_t(V) ] (w_q the quadrature weights):
 
-    p_n   = (1/eps_n) (-g_n)_+ ,
-    t_try = (g_t - g_t^p) / eps_t            (trial, g_t^p the slip of the last step),
-    t_t   = t_try                 if |t_try| <= mu_f p_n      (stick)
-          = mu_f p_n sign(t_try)  otherwise                   (slip; open: p_n = 0),
+    R(U) = K U + f_c(U) - F_ext = 0   on the free dofs,
 
-and after a converged load step the slip is updated, g_t^p <- g_t - eps_t t_t (backward
-Euler).  The traction exerted on the slave body is  p_n n_m - t_t t_m , on the master
-its negative.  Weak form: with the internal contact force
-f_c(U) . V = sum_q w_q [ -p_n dg_n(V) + t_t dg_t(V) ] (w_q the quadrature weights),
+and the consistent tangent K + G_n^T W_n G_n + G_t^T (W_t G_t - W_tn G_n) (G_n, G_t the
+sparse maps U -> dg_n, dg_t at the points, W the diagonal law derivatives of
+:class:`hpfebe.contact.laws.LawState` times the weights): non-symmetric in slip.
 
-    R(U) = F_ext - K U - f_c(U) = 0   on the free dofs.
+A rigid obstacle as master (:class:`hpfebe.contact.bodies.RigidObstacle`): the points are
+Gauss points of the slave's contact elements, n_m = -n (n the slave's outward normal),
+t_m its tangent, g_n = g(x) - U_n, g_t = U_t - w(x): the one-body problems of Sections
+3.2-3.3 (:func:`hpfebe.contact.friction.solve_friction`).
 
-Consistent linearisation (4.35) and Section 4.2.5, pointwise, with the active indicator
-H = [g_n <= 0] (g_n = 0 counts as active: sign(0) := 1 in Remark 4.2.2, so bodies that
-touch in the reference state get contact stiffness in the first Newton step):
-
-    d(-p_n) = (H / eps_n) dg_n,
-    d t_t   = (1/eps_t) dg_t                               (stick),
-            = -mu_f sign(t_try) (H / eps_n) dg_n           (slip),
-
-so the tangent  K + G_n^T W_n G_n + G_t^T (W_t G_t + W_tn G_n)  (G_n, G_t the sparse maps
-U -> dg_n, dg_t at the points, W diagonal) is the exact (generalised) derivative of
-R; it is non-symmetric in slip.  Points with g_n > 0 are open: p_n = t_t = 0 (their
-slip follows the relative motion, g_t^p <- g_t).  With mu_f = 0 (frictionless) the
-tangential terms vanish and active points are reported as SLIP (t_t = 0 = mu_f p_n).
-Semismooth Newton: in the piecewise linear setting it terminates once the active and
-stick/slip sets are right (the last step drops the residual to rounding); changes of
-those sets may take a few non-monotone iterations - or cycle forever between two sets
-(measured: the Figure 4.13 scene on its initial mesh h = 1/2 with P1 triangles).
-Globalisation (``line_search=True``, off by default so that the plain iteration of the
-thesis is what runs unless asked for): Armijo backtracking alpha = 1, 1/2, 1/4, ... on
-the merit ||R_free||_2, accepting ||R(U + alpha dU)|| <= (1 - 1e-4 alpha) ||R(U)||.
-Justification: R is piecewise linear in U and dU solves the Newton system of the current
-piece, so for small alpha ||R(U + alpha dU)|| = (1 - alpha) ||R(U)|| (when U is interior
-to its piece; on a kink the one-sided derivative of the new piece enters): the search
-succeeds, the residual decreases strictly, and a state once left cannot be met again
-with the same residual - no cycle; near the solution the full step is accepted and the
-finite termination is kept.  Below ``min_step`` the last trial step is taken.  Non-
-symmetric in slip, the problem has no energy, hence the residual as merit.
-
-Algorithm 4.1: for every load factor lambda_j the external load F_ext(lambda_j) and the
-Dirichlet values (both arrays scaled by lambda, or callables of lambda) are applied, the
-start iterate is the last converged state with the new Dirichlet values, and Newton
-iterates until ||R_free||_2 <= atol + rtol * ref, ref = max(||F_ext,free||_2,
-||R^(0)_free||_2) of that step.  Failure (max_iter, non-finite residual or singular
-system: a linear solve whose relative residual exceeds 1e-6, e.g. a body held only by
-contact that has lost it) stops the loading and is reported (``converged=False`` and
-``reason``); the returned state is the last iterate of the failed step.
+Algorithm 4.1 (:meth:`TwoBodyContact.solve` on :func:`hpfebe.nonlinear.load_path`): for
+every load factor the load, the Dirichlet values and the obstacle motion are applied, the
+start iterate is the last converged state, semismooth Newton iterates (optionally with an
+Armijo line search on ||R||_2 or on the energy of a potential law; the semismooth
+iteration alone may cycle between two contact states, e.g. the Figure 4.13 scene on
+h = 1/2), and the slip is committed after convergence; failures are reported with a
+reason, or the step is cut and retried (``max_cuts``).  Dense systems (no FE body) are
+solved by LAPACK, sparse ones by a sparse LU with a check of its residual.
 """
 
 from __future__ import annotations
 
 import warnings
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Callable, Optional, Sequence, Union
 
 import numpy as np
+import scipy.linalg as sla
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from ..bem.lame import LameBEM
-from ..fem.elasticity import ElasticBody
+from ..nonlinear import Iterate, LineSearch, SingularStep, SolverInfo, load_path
 from ..quadrature import gauss_legendre
-from .bem_body import make_adapter
+from .bodies import as_body, pointwise
+from .laws import OPEN, SLIP, STATE_NAMES, STICK, penalty_friction, positive, \
+    tresca_energy, updated_slip
 
-OPEN, STICK, SLIP = 0, 1, 2
-STATE_NAMES = {OPEN: "open", STICK: "stick", SLIP: "slip"}
-
-
-def _positive(name: str, value) -> float:
-    v = float(value)
-    if not (np.isfinite(v) and v > 0):
-        raise ValueError(f"{name} must be positive and finite, got {value!r}")
-    return v
+MERITS = ("residual", "energy")
+SCALES = ("initial", "force")
 
 
 def project_onto_polyline(points: np.ndarray, a: np.ndarray, b: np.ndarray):
@@ -156,36 +123,22 @@ def project_onto_polyline(points: np.ndarray, a: np.ndarray, b: np.ndarray):
     return seg, s[i, seg], excess[i, seg], dist[i, seg]
 
 
-@dataclass
-class StepRecord:
-    """Diagnostics of one load step: load factor, Newton iterations, residual norms
-    ||R_free||_2 of every iterate (index 0 = start iterate), outcome, contact state
-    counts of the last iterate and the Newton step lengths (all 1 without line search)."""
-
-    load_factor: float
-    iterations: int
-    residuals: list
-    converged: bool
-    reason: str
-    n_stick: int = 0
-    n_slip: int = 0
-    n_open: int = 0
-    step_lengths: list = None
 
 
 @dataclass
-class TwoBodyResult:
-    """Outcome of :meth:`TwoBodyContact.solve`.
+class ContactResult:
+    """Outcome of :meth:`TwoBodyContact.solve` (and of :func:`solve_friction`).
 
     U : the global dof vector (slave dofs first); u_slave, u_master : its two parts
-    converged, reason : "converged", or why the loading stopped ("max_iter in step j",
-        "non-finite residual in step j", "singular Newton matrix in step j")
-    steps : one StepRecord per attempted load step
-    points : (n, 2) slave contact points (reference); weights : quadrature weights
-        (0 for points outside the master)
-    g_n, g_t, p_n, t_t : gap, relative tangential displacement, pressure and friction
-        traction at the points (last iterate); state : OPEN / STICK / SLIP codes;
-        slip : accumulated slip g_t^p after the last converged step
+    converged, reason : overall outcome (the reason names the failed load step)
+    info : SolverInfo of the load path; ``steps`` its SolverInfo per attempted load step
+        (load_factor, iterations, residuals, converged, reason, state_counts)
+    Contact state at the slave contact points (last iterate): points (n, 2), weights
+    (quadrature weights, 0 for points outside the master), g_n (signed gap, < 0 is
+    penetration), g_t (relative tangential displacement), p_n >= 0, t_t, bound (slip
+    bound s), state (OPEN / STICK / SLIP), slip (g_t^p after the last converged step)
+    load_vector, obstacle_motion : load and obstacle motion w of the last step (to
+    continue loading with ``initial=``)
     """
 
     U: np.ndarray
@@ -193,83 +146,170 @@ class TwoBodyResult:
     u_master: np.ndarray
     converged: bool
     reason: str
-    steps: list
+    info: SolverInfo
     points: np.ndarray
     weights: np.ndarray
     g_n: np.ndarray
     g_t: np.ndarray
     p_n: np.ndarray
     t_t: np.ndarray
+    bound: np.ndarray
     state: np.ndarray
     slip: np.ndarray
+    elements: np.ndarray = None
+    load_vector: np.ndarray = None
+    obstacle_motion: np.ndarray = None
+    friction: str = "coulomb"
 
     @property
-    def residual_histories(self) -> list:
-        return [s.residuals for s in self.steps]
+    def steps(self) -> list:
+        return self.info.steps
 
     @property
     def iterations(self) -> list:
         return [s.iterations for s in self.steps]
 
     @property
+    def residuals(self) -> list:
+        return [s.residuals for s in self.steps]
+
+    residual_histories = residuals
+
+    @property
     def state_names(self) -> list:
         return [STATE_NAMES[int(k)] for k in self.state]
 
+    @property
+    def stick(self) -> np.ndarray:
+        return self.state == STICK
+
+    @property
+    def slipping(self) -> np.ndarray:
+        return self.state == SLIP
+
+    @property
+    def gap_function(self) -> np.ndarray:
+        """U_n - g = -g_n (> 0: penetration)."""
+        return -self.g_n
+
+    @property
+    def rel_slip(self) -> np.ndarray:
+        return self.g_t
+
+    def total_forces(self) -> tuple[float, float]:
+        """(int p_n ds, int t_t ds) over Gamma_C."""
+        return float(self.weights @ self.p_n), float(self.weights @ self.t_t)
+
+
+TwoBodyResult = ContactResult
+
 
 class TwoBodyContact:
-    """Slave and master elastic bodies (FE or BE) in frictional penalty contact.
+    """Two bodies (FE, BE, or a BE/FE body against a rigid obstacle) in frictional
+    penalty contact.
 
     Parameters
     ----------
-    slave, master : :class:`hpfebe.fem.elasticity.ElasticBody` (FE) or
-        :class:`hpfebe.bem.lame.LameBEM` (BE)
+    slave, master : ElasticBody (FE), LameBEM (BE), or a body of
+        :mod:`hpfebe.contact.bodies` (:class:`RigidObstacle` for the master: one body
+        against a rigid obstacle, Sections 3.2-3.3)
     slave_boundary, master_boundary : labels (str or list) of Gamma_C^s, Gamma_C^m
-        (FE: facet labels of the mesh; BE: element labels of the boundary mesh)
+        (FE: facet labels; BE: element labels; ignored for a rigid master)
     eps_n, eps_t : penalty parameters (> 0); 1/eps are the contact stiffnesses
-    mu_f : Coulomb friction coefficient (>= 0; 0 = frictionless: no tangential terms)
-    nq : Gauss points per integration piece (>= 1; 2 integrates the P1/Q1 trace
-        products exactly; with a BE body at least p_max + 1 are taken)
+    mu_f : Coulomb coefficient (>= 0; 0 = frictionless), or F : Tresca bound (float or
+        callable of the points, >= 0; acts on all of Gamma_C)
+    nq : Gauss points per integration piece (two bodies: at least p_max + 1 with a BE
+        body; rigid master: per element, default p_I + 1 for a BE slave, 2 for FE)
     split : split the slave segments at the projections of the master vertices
     """
 
-    def __init__(
-        self,
-        slave: Union[ElasticBody, LameBEM],
-        master: Union[ElasticBody, LameBEM],
-        slave_boundary: Union[str, Sequence[str]],
-        master_boundary: Union[str, Sequence[str]],
-        eps_n: float,
-        eps_t: float = 1.0,
-        mu_f: float = 0.0,
-        nq: int = 2,
-        split: bool = True,
-    ):
-        if not isinstance(slave, (ElasticBody, LameBEM)):
-            raise ValueError(f"slave must be an ElasticBody or a LameBEM, got {type(slave).__name__}")
-        if not isinstance(master, (ElasticBody, LameBEM)):
-            raise ValueError(f"master must be an ElasticBody or a LameBEM, got {type(master).__name__}")
-        self.eps_n = _positive("eps_n", eps_n)
-        self.eps_t = _positive("eps_t", eps_t)
-        mu = float(mu_f)
-        if not (np.isfinite(mu) and mu >= 0):
-            raise ValueError(f"mu_f must be non-negative and finite, got {mu_f!r}")
-        self.mu_f = mu
-        if int(nq) != nq or nq < 1:
-            raise ValueError(f"nq must be a positive integer, got {nq!r}")
-        self.nq = int(nq)
-        self.split = bool(split)
+    def __init__(self, slave, master, slave_boundary, master_boundary=None,
+                 eps_n: float = None, eps_t: float = 1.0, mu_f: float = 0.0, F=None,
+                 nq: Optional[int] = 2, split: bool = True):
+        self.bodies = {"slave": as_body(slave, "slave"), "master": as_body(master, "master")}
         self.slave, self.master = slave, master
-        self.adapters = {"slave": make_adapter(slave), "master": make_adapter(master)}
-        sa, ma = self.adapters["slave"], self.adapters["master"]
-        self.offset = sa.ndofs
-        self.ndofs = sa.ndofs + ma.ndofs
-        # (4.27) / (4.33): FE blocks sparse, a BE block (dense S_hat) stored inside
-        self.K = sp.block_diag([sa.K, ma.K], format="csr")
-        self._build_contact(slave_boundary, master_boundary)
+        if self.bodies["slave"].kind == "rigid":
+            raise ValueError("slave must be a deformable body (the obstacle is the master)")
+        self.eps_n = positive("eps_n", eps_n)
+        self.eps_t = positive("eps_t", eps_t)
+        self.mu_f = positive("mu_f", mu_f, allow_zero=True)
+        if F is not None and self.mu_f > 0:
+            raise ValueError("give mu_f (Coulomb) or F (Tresca), not both")
+        if nq is not None and (isinstance(nq, bool) or int(nq) != nq or nq < 1):
+            raise ValueError(f"nq must be a positive integer, got {nq!r}")
+        self.nq = None if nq is None else int(nq)
+        self.split = bool(split)
+        sb, mb = self.bodies["slave"], self.bodies["master"]
+        self.offset = sb.ndofs
+        self.ndofs = sb.ndofs + mb.ndofs
+        # (4.27) / (4.33): FE blocks sparse, a BE block (dense S_hat) inside; a system
+        # without FE body (BE against rigid or BE) stays dense
+        self.dense = "FE" not in (sb.kind, mb.kind)
+        if self.dense:
+            Ks = [b.S for b in (sb, mb) if b.kind == "BE"]
+            self.K = sla.block_diag(*Ks)
+        else:
+            self.K = sp.block_diag([sb.K, mb.K], format="csr")
+        if mb.kind == "rigid":
+            self._build_rigid(slave_boundary)
+        else:
+            self._build_contact(slave_boundary, master_boundary)
+            self.motion = np.zeros(len(self.points))
+        self.F = None if F is None else pointwise("F", F, self.points, allow_negative=False)
+        self.law_name = "tresca" if F is not None else "coulomb"
 
     # ------------------------------------------------------------------ geometry
+    def _build_rigid(self, slave_boundary) -> None:
+        """Contact points of one body against a rigid obstacle: Gauss points on every
+        slave contact segment; the obstacle's normal is -n (n the body's outward
+        normal), its tangent the body's t, g_n = g(x) - U_n."""
+        S, obstacle = self.bodies["slave"], self.bodies["master"]
+        seg = S.segments(slave_boundary)
+        ids = seg["ids"]
+        if ids.size == 0:
+            raise ValueError(f"slave_boundary {slave_boundary!r}: no element carries this label")
+        deg = np.full(ids.size, S.degree) if S.kind == "FE" else S.mesh.degrees[ids]
+        pf, ps, pw = [], [], []
+        for m in np.unique(deg if self.nq is None else [self.nq]):
+            sel = np.flatnonzero(deg == m) if self.nq is None else np.arange(ids.size)
+            t, w = gauss_legendre(int(m) + 1 if self.nq is None else int(m))
+            pf.append(np.repeat(sel, t.size))
+            ps.append(np.tile(0.5 * (1.0 + np.asarray(t)), sel.size))
+            pw.append(np.tile(0.5 * np.asarray(w), sel.size))
+        order = np.argsort(np.concatenate(pf), kind="stable")
+        pf, ps, pw = (np.concatenate(v)[order] for v in (pf, ps, pw))
+        a, b = seg["a"][pf], seg["b"][pf]
+        self.points = a + ps[:, None] * (b - a)
+        self.weights = pw * np.linalg.norm(b - a, axis=1)
+        self.point_facets = ids[pf]
+        self.outside = np.zeros(pf.size, bool)
+        nm = -seg["normals"][pf]
+        self._set_traces(nm, [(S, ids[pf], ps, 0, 1.0)])
+        self.g0 = pointwise("gap", obstacle.gap, self.points)
+        self.motion = pointwise("obstacle_slip", obstacle.motion, self.points)
+
+    def _set_traces(self, nm, sides) -> None:
+        """Normals n_m, tangents t_m = (n_m,y, -n_m,x) and the sparse maps U -> dg_n,
+        dg_t at the points (one entry per trace basis function, component and side)."""
+        self.normals = nm
+        self.tangents = tm = np.column_stack([nm[:, 1], -nm[:, 0]])
+        n = nm.shape[0]
+        rows, cols, vn, vt = [], [], [], []
+        for body, ids, par, off, sign in sides:
+            tc, tv = body.trace(ids, par)
+            for j in range(tv.shape[1]):
+                for c in (0, 1):
+                    rows.append(np.arange(n))
+                    cols.append(tc[:, c, j] + off)
+                    vn.append(sign * tv[:, j] * nm[:, c])
+                    vt.append(sign * tv[:, j] * tm[:, c])
+        rows, cols = np.concatenate(rows), np.concatenate(cols)
+        shape = (n, self.ndofs)
+        self.Gn = sp.csr_matrix((np.concatenate(vn), (rows, cols)), shape=shape)
+        self.Gt = sp.csr_matrix((np.concatenate(vt), (rows, cols)), shape=shape)
+
     def _build_contact(self, slave_boundary, master_boundary) -> None:
-        S, M = self.adapters["slave"], self.adapters["master"]
+        S, M = self.bodies["slave"], self.bodies["master"]
         ssg = S.segments(slave_boundary)
         msg = M.segments(master_boundary)
         fs, xa, xb = ssg["ids"], ssg["a"], ssg["b"]
@@ -282,7 +322,7 @@ class TwoBodyContact:
         inner = (mexc == 0) & (ms > 1e-12) & (ms < 1 - 1e-12)
         if not self.split:
             inner[:] = False
-        nq = self.nq
+        nq = 2 if self.nq is None else self.nq
         if S.kind == "BE" or M.kind == "BE":
             nq = max(nq, max(S.degree, M.degree) + 1)
         t, w = gauss_legendre(nq)
@@ -313,32 +353,15 @@ class TwoBodyContact:
         counts = np.bincount(inv)
         vid = np.where(s < 0.5, inv[seg], inv[ma.size + seg])
         outside = (excess * seg_len[seg] > 1e-10 * seg_len.max()) & (counts[vid] == 1)
-        nm = normals[seg]
-        tm = np.column_stack([nm[:, 1], -nm[:, 0]])
         xm = A[seg] + s[:, None] * (B[seg] - A[seg])
         self.points = pts
         self.weights = np.where(outside, 0.0, wts)
         self.outside = outside
-        self.normals, self.tangents = nm, tm
         self.master_points = xm
+        nm = normals[seg]
         self.g0 = np.sum((pts - xm) * nm, axis=1)
-        # sparse maps U -> dg_n, dg_t: rows = points, one entry per trace basis function,
-        # component and side (the adapters' traces)
-        n = pts.shape[0]
-        rows, cols, vn, vt = [], [], [], []
-        for ad, ids, par, off, sign in ((S, fs[pf], ps, 0, 1.0),
-                                        (M, msg["ids"][seg], s, self.offset, -1.0)):
-            tc, tv = ad.trace(ids, par)
-            for j in range(tv.shape[1]):
-                for c in (0, 1):
-                    rows.append(np.arange(n))
-                    cols.append(tc[:, c, j] + off)
-                    vn.append(sign * tv[:, j] * nm[:, c])
-                    vt.append(sign * tv[:, j] * tm[:, c])
-        rows, cols = np.concatenate(rows), np.concatenate(cols)
-        shape = (n, self.ndofs)
-        self.Gn = sp.csr_matrix((np.concatenate(vn), (rows, cols)), shape=shape)
-        self.Gt = sp.csr_matrix((np.concatenate(vt), (rows, cols)), shape=shape)
+        self._set_traces(nm, [(S, fs[pf], ps, 0, 1.0),
+                              (M, msg["ids"][seg], s, self.offset, -1.0)])
 
     # ------------------------------------------------------------------ dof helpers
     def global_dofs(self, body: str, dofs: np.ndarray) -> np.ndarray:
@@ -350,26 +373,26 @@ class TwoBodyContact:
         raise ValueError(f"body must be 'slave' or 'master', got {body!r}")
 
     def dofs_on(self, body: str, labels, component: Optional[int] = None) -> np.ndarray:
-        return self.global_dofs(body, self._adapter(body).dofs_on(labels, component))
+        return self.global_dofs(body, self._contact_body(body).dofs_on(labels, component))
 
     def dofs_at(self, body: str, point, component: Optional[int] = None) -> np.ndarray:
-        return self.global_dofs(body, self._adapter(body).dofs_at(point, component))
+        return self.global_dofs(body, self._contact_body(body).dofs_at(point, component))
 
     def traction_load(self, body: str, label: str, traction) -> np.ndarray:
         """Global load vector of a traction on the boundary part ``label`` of ``body``."""
-        ad = self._adapter(body)
+        ad = self._contact_body(body)
         f = np.zeros(self.ndofs)
         f[self.global_dofs(body, np.arange(ad.ndofs))] = ad.traction_load(label, traction)
         return f
 
     def dof_coordinates(self) -> np.ndarray:
-        return np.vstack([self.adapters["slave"].dof_coordinates(),
-                          self.adapters["master"].dof_coordinates()])
+        return np.vstack([self.bodies["slave"].dof_coordinates(),
+                          self.bodies["master"].dof_coordinates()])
 
     def displacement_at(self, body: str, U: np.ndarray, labels, s) -> np.ndarray:
         """(n, 2) displacement of ``body`` (global dof vector U) at the points
         a + s (b - a) of its segments on ``labels`` (n = number of segments x len(s))."""
-        ad = self._adapter(body)
+        ad = self._contact_body(body)
         sg = ad.segments(labels)
         s = np.atleast_1d(np.asarray(s, dtype=float))
         ids = np.repeat(sg["ids"], s.size)
@@ -378,187 +401,274 @@ class TwoBodyContact:
         u = np.asarray(U)[self.global_dofs(body, np.arange(ad.ndofs))]
         return np.einsum("nj,ncj->nc", tv, u[tc])
 
-    def _adapter(self, body: str):
+    def _contact_body(self, body: str):
         if body in ("slave", "master"):
-            return self.adapters[body]
+            return self.bodies[body]
         raise ValueError(f"body must be 'slave' or 'master', got {body!r}")
 
     def _body(self, body: str):
-        return self._adapter(body).body
+        return self._contact_body(body).body
 
     # ------------------------------------------------------------------ contact law
-    def contact_state(self, U: np.ndarray, slip: np.ndarray):
-        """Pointwise gap, pressure, friction traction, state and the tangent weights."""
+    def contact_state(self, U: np.ndarray, slip: np.ndarray, motion=None) -> dict:
+        """Gap g_n, relative tangential displacement g_t and the law at U."""
         g_n = self.g0 + self.Gn @ U
-        g_t = self.Gt @ U
-        active = (g_n <= 0.0) & ~self.outside
-        p_n = np.where(active, -g_n / self.eps_n, 0.0)
-        kn = np.where(active, 1.0 / self.eps_n, 0.0)
-        if self.mu_f > 0:
-            t_try = np.where(active, (g_t - slip) / self.eps_t, 0.0)
-            bound = self.mu_f * p_n
-            stick = active & (np.abs(t_try) <= bound)
-            slipping = active & ~stick
-            sgn = np.sign(t_try)
-            t_t = np.where(stick, t_try, np.where(slipping, bound * sgn, 0.0))
-            kt = np.where(stick, 1.0 / self.eps_t, 0.0)
-            ktn = np.where(slipping, -self.mu_f * sgn / self.eps_n, 0.0)
-        else:
-            t_t = np.zeros_like(g_n)
-            kt = np.zeros_like(g_n)
-            ktn = np.zeros_like(g_n)
-            stick = np.zeros(g_n.shape, bool)
-            slipping = active
-        state = np.full(g_n.shape, OPEN, dtype=np.int8)
-        state[stick] = STICK
-        state[slipping] = SLIP
-        return dict(g_n=g_n, g_t=g_t, p_n=p_n, t_t=t_t, state=state, kn=kn, kt=kt, ktn=ktn)
+        g_t = self.Gt @ U - (self.motion if motion is None else motion)
+        law = penalty_friction(-g_n, g_t, slip, self.eps_n, self.eps_t,
+                               mu_f=self.mu_f if self.F is None else None, F=self.F,
+                               active=~self.outside)
+        return dict(g_n=g_n, g_t=g_t, p_n=law.p_n, t_t=law.t_t, state=law.state, law=law)
 
-    def internal_force(self, U: np.ndarray, slip: np.ndarray):
+    def contact_force(self, cs: dict) -> np.ndarray:
+        """f_c(U) = sum_q w_q [-p_n dg_n + t_t dg_t] (the traction on the slave is
+        p_n n_m - t_t t_m, on the master its negative)."""
+        w = self.weights
+        return self.Gn.T @ (w * -cs["p_n"]) + self.Gt.T @ (w * cs["t_t"])
+
+    def internal_force(self, U: np.ndarray, slip: np.ndarray, motion=None):
         """K U + f_c(U) and the contact state at U."""
-        cs = self.contact_state(U, slip)
-        w = self.weights
-        f = self.K @ U + self.Gn.T @ (w * -cs["p_n"]) + self.Gt.T @ (w * cs["t_t"])
-        return f, cs
+        cs = self.contact_state(U, slip, motion)
+        return self.K @ U + self.contact_force(cs), cs
 
-    def tangent(self, cs: dict) -> sp.csr_matrix:
-        """Consistent Newton matrix K + C (Section 4.2.5) for the state ``cs``."""
+    def contact_tangent(self, law) -> sp.csr_matrix:
+        """Linearised contact terms (Section 4.2.5): Gn^T W_n Gn + Gt^T (W_t Gt - W_tn Gn),
+        W = diag(w dp_n), diag(w dt_t), diag(w dt_n)."""
         w = self.weights
-        C = self.Gn.T @ sp.diags(w * cs["kn"]) @ self.Gn
-        if self.mu_f > 0:
-            C = C + self.Gt.T @ (sp.diags(w * cs["kt"]) @ self.Gt + sp.diags(w * cs["ktn"]) @ self.Gn)
-        return (self.K + C).tocsr()
+        C = self.Gn.T @ sp.diags(w * law.dp_n) @ self.Gn
+        if np.any(law.dt_t) or np.any(law.dt_n):
+            C = C + self.Gt.T @ (sp.diags(w * law.dt_t) @ self.Gt
+                                 - sp.diags(w * law.dt_n) @ self.Gn)
+        return C
+
+    def tangent(self, cs: dict):
+        """Consistent Newton matrix K + C for the state ``cs`` (dense without FE body)."""
+        C = self.contact_tangent(cs["law"])
+        return self.K + C.toarray() if self.dense else (self.K + C).tocsr()
+
+    def energy(self, U: np.ndarray, cs: dict, f: np.ndarray) -> float:
+        """1/2 U.K U - f.U + contact potential: the merit of the potential laws
+        (frictionless, Tresca), whose gradient is the residual."""
+        F = 0.0 if self.F is None else self.F
+        pot = tresca_energy(cs["law"], self.eps_n, self.eps_t, F)
+        return float(0.5 * U @ (self.K @ U) - f @ U + self.weights @ pot)
 
     # ------------------------------------------------------------------ Algorithm 4.1
-    def solve(
-        self,
-        f_ext: Union[np.ndarray, Callable[[float], np.ndarray], None] = None,
-        fixed_dofs: Optional[np.ndarray] = None,
-        fixed_values: Union[np.ndarray, Callable[[float], np.ndarray], float, None] = None,
-        load_factors: Sequence[float] = (1.0,),
-        rtol: float = 1e-10,
-        atol: float = 0.0,
-        max_iter: int = 30,
-        line_search: bool = False,
-        min_step: float = 2.0 ** -12,
-    ) -> TwoBodyResult:
-        """Incremental loading with Newton's method (Algorithm 4.1).
+    def solve(self, f_ext=None, fixed_dofs=None, fixed_values=None,
+              load_factors: Sequence[float] = (1.0,), rtol: float = 1e-10,
+              atol: float = 0.0, max_iter: int = 30, line_search: bool = False,
+              min_step: float = 2.0 ** -12, max_cuts: int = 0, norm: str = "l2",
+              merit: str = "residual", scale: str = "initial", predictor: bool = False,
+              initial: ContactResult | None = None) -> ContactResult:
+        """Incremental loading with semismooth Newton (Algorithm 4.1,
+        :func:`hpfebe.nonlinear.load_path`).
 
-        ``f_ext`` (global load vector at load factor 1, scaled by lambda, or a callable
-        lambda -> vector), ``fixed_dofs`` (global Dirichlet dofs) with ``fixed_values``
-        (values at lambda = 1, scaled; a callable lambda -> values; None = 0),
-        ``load_factors`` increasing pseudo-times lambda_1 < lambda_2 < ...;
-        ``line_search`` Armijo backtracking on ||R_free|| (module docstring) down to
-        step length ``min_step``; the step lengths are in ``StepRecord.step_lengths``."""
-        N = self.ndofs
+        ``f_ext`` global load at load factor 1 (scaled by lambda) or a callable
+        lambda -> vector; ``fixed_dofs`` with ``fixed_values`` (at lambda = 1, scaled;
+        a callable; None = 0); the obstacle motion is ramped like the load;
+        ``load_factors`` increasing; a failed step is halved and retried from the last
+        converged state at most ``max_cuts`` times.  Newton stops when
+        ||R_free|| <= atol + rtol * scale, ``norm`` "l2" or "max", ``scale`` "initial"
+        (max(||F_ext||, ||R^(0)||) of the step) or "force" (max of the load, the
+        residual at U = 0 and |K U| of the iterate).  ``line_search``: Armijo on
+        ``merit`` ("residual": ||R||_2, down to ``min_step``; "energy": the potential,
+        for frictionless and Tresca contact, 30 halvings); cycling of the contact
+        state is then detected.  ``predictor``: start each step from the bonded
+        solution (every point in contact and sticking) when it lowers the merit.
+        ``initial``: a converged result of this problem to continue from (U, slip,
+        load and obstacle motion ramped from its final values)."""
+        steps = _LoadSteps(self, f_ext, fixed_dofs, fixed_values, merit, scale, initial)
         lf = np.asarray(load_factors, dtype=float).ravel()
         if lf.size == 0 or not np.all(np.isfinite(lf)):
             raise ValueError(f"load_factors must be a non-empty finite sequence, got {load_factors!r}")
-        rtol = float(rtol)
-        if not (np.isfinite(rtol) and rtol >= 0):
-            raise ValueError(f"rtol must be non-negative, got {rtol!r}")
-        atol = float(atol)
-        if not (np.isfinite(atol) and atol >= 0):
-            raise ValueError(f"atol must be non-negative, got {atol!r}")
-        if rtol == 0 and atol == 0:
+        tol = positive("rtol", rtol, allow_zero=True)
+        atol = positive("atol", atol, allow_zero=True)
+        if tol == 0 and atol == 0:
             raise ValueError("rtol and atol must not both be zero")
-        if int(max_iter) != max_iter or max_iter < 1:
+        if isinstance(max_iter, bool) or int(max_iter) != max_iter or max_iter < 1:
             raise ValueError(f"max_iter must be a positive integer, got {max_iter!r}")
         min_step = float(min_step)
         if not (np.isfinite(min_step) and 0 < min_step <= 1):
             raise ValueError(f"min_step must lie in (0, 1], got {min_step!r}")
+        if norm not in ("l2", "max"):
+            raise ValueError(f"norm must be 'l2' or 'max', got {norm!r}")
+        if merit == "energy":
+            ls = LineSearch(enabled=line_search)
+        else:
+            ls = LineSearch(slack=0.0, max_halvings=int(round(-np.log2(min_step))),
+                            accept_last=True, enabled=line_search)
+        steps.detect_cycling = line_search
+        it, info = load_path(steps, lf, steps.x0, max_cuts=max_cuts, lam0=0.0, tol=tol,
+                             atol=atol, max_iter=int(max_iter), line_search=ls,
+                             norm=np.inf if norm == "max" else 2,
+                             predictor=steps.bonded_predictor if predictor else None)
+        return self._result(it, info, steps)
+
+    def _result(self, it: Iterate, info: SolverInfo, steps) -> ContactResult:
+        U, cs = it.x, it.data
+        return ContactResult(
+            U=U.copy(), u_slave=U[: self.offset].copy(), u_master=U[self.offset:].copy(),
+            converged=info.converged, reason=info.reason, info=info, points=self.points,
+            weights=self.weights, g_n=cs["g_n"], g_t=cs["g_t"], p_n=cs["p_n"],
+            t_t=cs["t_t"], bound=np.asarray(cs["law"].bound, dtype=float),
+            state=cs["state"], slip=steps.slip, elements=self.point_facets,
+            load_vector=steps.f, obstacle_motion=steps.w, friction=self.law_name)
+
+
+class _LoadSteps:
+    """The load steps of :meth:`TwoBodyContact.solve`: the Newton problem at a load
+    factor (residual R = K U + f_c(U) - F_ext on the free dofs), its start, and the
+    commit of the slip after a converged step (:class:`hpfebe.nonlinear.LoadStep`)."""
+
+    def __init__(self, pr: TwoBodyContact, f_ext, fixed_dofs, fixed_values, merit, scale,
+                 initial):
+        if merit not in MERITS:
+            raise ValueError(f"merit must be one of {MERITS}, got {merit!r}")
+        if merit == "energy" and pr.mu_f > 0:
+            raise ValueError("merit='energy' needs a potential law (frictionless or "
+                             "Tresca); Coulomb friction has none: use merit='residual'")
+        if scale not in SCALES:
+            raise ValueError(f"scale must be one of {SCALES}, got {scale!r}")
+        self.pr, self.merit, self.scale_rule = pr, merit, scale
+        N = pr.ndofs
         fixed = np.asarray([] if fixed_dofs is None else fixed_dofs, dtype=np.int64).ravel()
         if fixed.size and (fixed.min() < 0 or fixed.max() >= N):
             raise ValueError(f"fixed_dofs must lie in [0, {N}), got range [{fixed.min()}, {fixed.max()}]")
         if np.unique(fixed).size != fixed.size:
             raise ValueError("fixed_dofs must not contain duplicates")
-        free = np.setdiff1d(np.arange(N), fixed)
+        self.fixed, self.free = fixed, np.setdiff1d(np.arange(N), fixed)
+        self.f_ext, self.fixed_values = f_ext, fixed_values
+        self.x0, self.slip = np.zeros(N), np.zeros(pr.points.shape[0])
+        self.f0, self.w0 = np.zeros(N), np.zeros_like(self.slip)
+        if initial is not None:
+            self._continue_from(initial)
+        self.f, self.w = self.f0, self.w0
+        self.detect_cycling = False
 
-        def load_at(lam):
-            if f_ext is None:
-                f = np.zeros(N)
-            elif callable(f_ext):
-                f = np.asarray(f_ext(lam), dtype=float)
-            else:
-                f = lam * np.asarray(f_ext, dtype=float)
-            if f.shape != (N,):
-                raise ValueError(f"f_ext must have shape ({N},), got {f.shape}")
-            if fixed_values is None:
-                g = np.zeros(fixed.size)
-            elif callable(fixed_values):
-                g = np.asarray(fixed_values(lam), dtype=float) * np.ones(fixed.size)
-            else:
-                g = lam * np.asarray(fixed_values, dtype=float) * np.ones(fixed.size)
-            if g.shape != (fixed.size,):
-                raise ValueError(f"fixed_values must have shape ({fixed.size},), got {g.shape}")
-            return f, g
+    def _continue_from(self, initial: ContactResult) -> None:
+        pr = self.pr
+        if not isinstance(initial, ContactResult) or initial.U.shape != (pr.ndofs,) or \
+                initial.points.shape != pr.points.shape or \
+                not np.allclose(initial.points, pr.points) or initial.friction != pr.law_name:
+            raise ValueError("initial must be a result of the same bodies, contact points "
+                             "and friction law")
+        if not initial.converged:
+            raise ValueError(f"initial did not converge ({initial.reason}); not a state "
+                             "to continue from")
+        self.x0, self.slip = initial.U.copy(), initial.slip.copy()
+        self.f0, self.w0 = initial.load_vector.copy(), initial.obstacle_motion.copy()
 
-        U = np.zeros(N)
-        slip = np.zeros(self.points.shape[0])
-        steps: list = []
-        converged, reason = True, "converged"
-        cs = self.contact_state(U, slip)
-        for j, lam in enumerate(lf):
-            f, g = load_at(lam)
-            U[fixed] = g
-            ref = None
-            res_hist: list = []
-            ok, why = False, ""
-            lengths: list = []
-            fint, cs = self.internal_force(U, slip)
-            for k in range(int(max_iter) + 1):
-                r = (f - fint)[free]
-                rn = float(np.linalg.norm(r))
-                res_hist.append(rn)
-                if not np.isfinite(rn):
-                    why = f"non-finite residual in step {j}"
-                    break
-                if ref is None:
-                    ref = max(float(np.linalg.norm(f[free])), rn)
-                if rn <= atol + rtol * ref:
-                    ok, why = True, "converged"
-                    break
-                if k == int(max_iter):
-                    why = f"max_iter ({max_iter}) reached in step {j}"
-                    break
-                A = self.tangent(cs)[free][:, free].tocsc()
-                try:
-                    with warnings.catch_warnings():
-                        warnings.simplefilter("ignore", spla.MatrixRankWarning)
-                        dU = spla.splu(A).solve(r)
-                except RuntimeError:
-                    dU = np.full(free.size, np.nan)
-                if not np.all(np.isfinite(dU)) or (
-                    np.linalg.norm(A @ dU - r) > 1e-6 * rn
-                ):
-                    why = f"singular Newton matrix in step {j}"
-                    break
-                alpha = 1.0
-                while True:
-                    Ut = U.copy()
-                    Ut[free] += alpha * dU
-                    fint_t, cs_t = self.internal_force(Ut, slip)
-                    rt = float(np.linalg.norm((f - fint_t)[free]))
-                    # Armijo on the merit ||R_free||_2 (the full step always when
-                    # line_search is off); below min_step the last trial is taken
-                    if (not line_search or rt <= (1.0 - 1e-4 * alpha) * rn
-                            or alpha * 0.5 < min_step):
-                        break
-                    alpha *= 0.5
-                lengths.append(alpha)
-                U, fint, cs = Ut, fint_t, cs_t
-            st = cs["state"]
-            steps.append(StepRecord(float(lam), len(res_hist) - 1, res_hist, ok, why,
-                                    int(np.sum(st == STICK)), int(np.sum(st == SLIP)),
-                                    int(np.sum(st == OPEN)), lengths))
-            if not ok:
-                converged, reason = False, why
-                break
-            # backward Euler update of the slip (tangential "macro-displacement")
-            slip = np.where(cs["state"] == OPEN, cs["g_t"], cs["g_t"] - self.eps_t * cs["t_t"])
-        return TwoBodyResult(
-            U=U.copy(), u_slave=U[: self.offset].copy(), u_master=U[self.offset:].copy(),
-            converged=converged, reason=reason, steps=steps, points=self.points,
-            weights=self.weights, g_n=cs["g_n"], g_t=cs["g_t"], p_n=cs["p_n"],
-            t_t=cs["t_t"], state=cs["state"], slip=slip,
-        )
+    def _load(self, lam: float):
+        N, fixed = self.pr.ndofs, self.fixed
+        if self.f_ext is None:
+            f = np.zeros(N)
+        elif callable(self.f_ext):
+            f = np.asarray(self.f_ext(lam), dtype=float)
+        else:
+            f = np.asarray(self.f_ext, dtype=float)
+            if f.shape == (N,):
+                f = self.f0 + lam * (f - self.f0)
+        if f.shape != (N,):
+            raise ValueError(f"f_ext must have shape ({N},), got {f.shape}")
+        if not np.all(np.isfinite(f)):
+            raise ValueError("f_ext must be finite")
+        v = self.fixed_values
+        if v is None:
+            g = np.zeros(fixed.size)
+        elif callable(v):
+            g = np.asarray(v(lam), dtype=float) * np.ones(fixed.size)
+        else:
+            g = lam * np.asarray(v, dtype=float) * np.ones(fixed.size)
+        if g.shape != (fixed.size,):
+            raise ValueError(f"fixed_values must have shape ({fixed.size},), got {g.shape}")
+        return f, g
+
+    # LoadStep protocol
+    def problem(self, lam: float):
+        self.f, self.g_fixed = self._load(lam)
+        self.w = self.w0 + lam * (self.pr.motion - self.w0)
+        self.ref = None
+        if self.scale_rule == "force":
+            r0 = self.pr.internal_force(np.zeros(self.pr.ndofs), self.slip, self.w)[0] - self.f
+            self.ref = max(np.abs(self.f).max(initial=0.0),
+                           np.abs(r0[self.free]).max(initial=0.0), 1e-300)
+        return self
+
+    def start(self, x: np.ndarray, lam: float) -> np.ndarray:
+        x = x.copy()
+        x[self.fixed] = self.g_fixed
+        return x
+
+    def commit(self, it: Iterate) -> None:
+        self.slip = updated_slip(it.data["g_t"], it.data["law"], self.pr.eps_t)
+
+    def record(self, it: Iterate, info: SolverInfo) -> None:
+        st = it.data["state"]
+        info.counts = {name: int(np.sum(st == code)) for code, name in STATE_NAMES.items()}
+
+    # NewtonProblem protocol
+    def evaluate(self, U: np.ndarray) -> Iterate:
+        pr, free = self.pr, self.free
+        fint, cs = pr.internal_force(U, self.slip, self.w)
+        R = (fint - self.f)[free]
+        if self.scale_rule == "initial":
+            if self.ref is None:
+                self.ref = max(float(np.linalg.norm(self.f[free])), float(np.linalg.norm(R)))
+            scale = self.ref
+        else:
+            scale = max(self.ref, np.abs((pr.K @ U)[free]).max(initial=0.0))
+        merit = pr.energy(U, cs, self.f) if self.merit == "energy" \
+            else float(np.linalg.norm(R))
+        key = cs["law"].key if self.detect_cycling else None
+        return Iterate(U, R, merit, scale, key, cs)
+
+    def slope(self, it: Iterate, dx: np.ndarray) -> float:
+        return float(it.residual @ dx[self.free]) if self.merit == "energy" else -it.merit
+
+    def _solve(self, A, r: np.ndarray) -> np.ndarray:
+        free = self.free
+        if self.pr.dense:
+            try:
+                with warnings.catch_warnings():
+                    warnings.simplefilter("error", sla.LinAlgWarning)
+                    d = sla.solve(A[np.ix_(free, free)], r)
+            except (np.linalg.LinAlgError, ValueError, sla.LinAlgWarning):
+                raise SingularStep("singular Newton matrix (body not fixed?)") from None
+        else:
+            Af = A[free][:, free].tocsc()
+            try:
+                with warnings.catch_warnings():
+                    warnings.simplefilter("ignore", spla.MatrixRankWarning)
+                    d = spla.splu(Af).solve(r)
+            except RuntimeError:
+                d = np.full(free.size, np.nan)
+            if np.all(np.isfinite(d)) and \
+                    np.linalg.norm(Af @ d - r) > 1e-6 * np.linalg.norm(r):
+                d[:] = np.nan
+        if not np.all(np.isfinite(d)):
+            raise SingularStep("singular Newton matrix (body not fixed?)")
+        dx = np.zeros(self.pr.ndofs)
+        dx[free] = d
+        return dx
+
+    def step(self, it: Iterate) -> np.ndarray:
+        return self._solve(self.pr.tangent(it.data), -it.residual)
+
+    def bonded_predictor(self, it: Iterate):
+        """The bonded solution (every point in contact and sticking, relative to the
+        current slip): the law replaced by the linear springs 1/eps_n, 1/eps_t; None if
+        singular."""
+        pr, n = self.pr, len(self.slip)
+        w = pr.weights
+        ones = np.ones(n)
+        cs = it.data
+        pen = -cs["g_n"]
+        rel = cs["g_t"] - self.slip
+        Rb = pr.K @ it.x - self.f + pr.Gn.T @ (w * -pen / pr.eps_n) \
+            + pr.Gt.T @ (w * rel / pr.eps_t)
+        C = pr.Gn.T @ sp.diags(w * ones / pr.eps_n) @ pr.Gn \
+            + pr.Gt.T @ sp.diags(w * ones / pr.eps_t) @ pr.Gt
+        A = pr.K + C.toarray() if pr.dense else (pr.K + C).tocsr()
+        try:
+            return it.x + self._solve(A, -Rb[self.free])
+        except SingularStep:
+            return None

@@ -1,37 +1,32 @@
-"""Body adapters for :class:`hpfebe.contact.two_body.TwoBodyContact`: one small interface
-that hides whether a contact body is discretised by finite elements (P1/Q1,
-:class:`hpfebe.fem.elasticity.ElasticBody`) or by boundary elements (Galerkin BEM,
-:class:`hpfebe.bem.lame.LameBEM`), so that the contact code (gap, projection, return map,
-linearisation, Newton) is written once for FE/FE, FE/BE, BE/FE and BE/BE
-(Chapter 4, Section 4.2: block systems (4.27) and (4.33)).
+"""Bodies of the contact problems (Chapter 4, Section 4.2: block systems (4.27) FE/BE and
+(4.33) BE/BE): one protocol for a finite element body (:class:`FEBody`, P1/Q1
+:class:`hpfebe.fem.elasticity.ElasticBody`), a boundary element body (:class:`BEBody`,
+:class:`hpfebe.bem.lame.LameBEM`) and a rigid obstacle (:class:`RigidObstacle`, no dofs),
+so that the contact code (gap, projection, laws, Newton) is written once for every pair.
 
-What the contact code needs from a body (the adapter interface):
+The protocol:
 
-    ndofs, K                 number of unknowns and stiffness (sparse; for a BE body the
-                             dense S_hat stored as a (fully populated) sparse block, so that
-                             the global Newton matrix stays sparse in its FE blocks)
-    segments(labels)         the straight pieces of the contact boundary: end points a, b,
-                             end vertex ids (for polyline ends), outward unit normals and
-                             the body's own facet / element ids
-    trace(ids, s)            the linear map dofs -> displacement at the points
-                             a + s (b - a) of segments ``ids``: columns (n, 2, k) (dof of
-                             component c of local basis function j) and values (n, k)
-    degree                   polynomial degree of the traces (the contact quadrature
-                             takes degree + 1 Gauss points per piece to be exact)
+    kind, ndofs, K            "FE" / "BE" / "rigid", number of unknowns, stiffness (sparse;
+                              a BE body's dense S_hat is stored as a fully populated sparse
+                              block, so that the FE blocks of the global matrix stay sparse)
+    internal_force(u)         (f_int(u), tangent): K u and K for a linear body; a plastic
+                              body returns its return-map force and algorithmic tangent,
+                              with its history updated per call ...
+    commit(u)                 ... and committed when a load step converges
+    segments(labels)          straight pieces of the contact boundary: end points a, b, end
+                              vertex ids, outward unit normals, the body's facet/element ids
+    trace(ids, s)             dofs -> displacement at a + s (b - a) of segments ``ids``:
+                              columns (n, 2, k) and values (n, k)
+    degree                    polynomial degree of the traces
     dofs_on / dofs_at / traction_load / dof_coordinates   boundary conditions and loads
 
-FE body: the traces on a facet are the two vertex hat functions (1 - s, s).
-BE body: the unknowns are the boundary displacement in V_hp^2 (continuous Gauss-Lobatto
-Lagrange basis of degree p_I per element, interleaved components 2 * scalar dof + c,
-:mod:`hpfebe.spaces`), its stiffness the discrete Steklov-Poincare operator S_hat
-(Section 1.4); the trace on an element is the GLL Lagrange basis at t = 2 s - 1.
-
-This is the structure of the thesis's systems: in (4.27) (FE/BE, the slave discretised
-by BE) the slave's block is the dense S on its Neumann and contact boundary dofs, the
-master's the sparse FE matrix, and the two are coupled only through the contact blocks C_ss, C_sm, C_ms, C_mm; in (4.33) (BE/BE) both
-body blocks are dense S.  Dirichlet dofs are kept in the vector and eliminated by the
-solver (``fixed_dofs``), not dropped from the space.  Plasticity (A_pl, B_pl of (4.27))
-is not part of this module.
+FE body: traces on a facet are the two vertex hat functions (1 - s, s).  BE body: the
+unknowns are the boundary displacement in V_hp^2 (GLL Lagrange basis of degree p_I,
+interleaved components 2 * scalar dof + c, :mod:`hpfebe.spaces`), its stiffness the
+discrete Steklov-Poincare operator S_hat (Section 1.4).  Rigid obstacle: a gap function
+g(x) (admissible U_n <= g for the other body's outward normal n) and a prescribed
+tangential motion w(x); it has no dofs.  Dirichlet dofs stay in the vector and are
+eliminated by the solver (``fixed_dofs``).
 """
 
 from __future__ import annotations
@@ -51,8 +46,18 @@ def _labels(labels) -> list:
     return [labels] if isinstance(labels, str) else list(labels)
 
 
-class FEBodyAdapter:
-    """Adapter of a P1/Q1 :class:`ElasticBody` (facets of its labelled boundary)."""
+class _LinearBody:
+    """internal_force / commit of a linear body: K u and K, no history."""
+
+    def internal_force(self, u):
+        return self.K @ u, self.K
+
+    def commit(self, u) -> None:
+        pass
+
+
+class FEBody(_LinearBody):
+    """A P1/Q1 :class:`ElasticBody` (facets of its labelled boundary)."""
 
     kind = "FE"
     degree = 1
@@ -90,19 +95,22 @@ class FEBodyAdapter:
         return self.body.dof_coordinates()
 
 
-class BEBodyAdapter:
-    """Adapter of a :class:`LameBEM` body: unknowns = boundary displacement in V_hp^2,
+class BEBody(_LinearBody):
+    """A :class:`LameBEM` body: unknowns = boundary displacement in V_hp^2,
     stiffness S_hat, contact boundary = the elements carrying the contact labels."""
 
     kind = "BE"
 
-    def __init__(self, bem: LameBEM):
+    def __init__(self, bem: LameBEM, S=None):
         self.body = bem
         self.mesh = bem.mesh
         self.space = bem.V_space
         self.ndofs = 2 * self.space.ndof
         self.degree = int(self.mesh.degrees.max())
-        self.K = sp.csr_matrix(bem.S_hat)
+        self.S = bem.S_hat if S is None else np.asarray(S, dtype=float)
+        if self.S.shape != (self.ndofs, self.ndofs):
+            raise ValueError(f"S must have shape {(self.ndofs, self.ndofs)}, got {self.S.shape}")
+        self.K = sp.csr_matrix(self.S)
 
     def _elements(self, labels) -> np.ndarray:
         labels = _labels(labels)
@@ -205,10 +213,57 @@ class BEBodyAdapter:
         return f
 
 
-def make_adapter(body):
-    """The adapter of an FE body (:class:`ElasticBody`) or a BE body (:class:`LameBEM`)."""
+class RigidObstacle:
+    """A rigid obstacle: gap g(x) on the other body's contact boundary (admissible
+    U_n <= g, g < 0 an initial overlap) and its tangential motion w(x) along the contact
+    tangent; each a float or a callable of the points (n, 2).  No dofs."""
+
+    kind = "rigid"
+    ndofs = 0
+    degree = 0
+
+    def __init__(self, gap, motion=None):
+        self.gap, self.motion = gap, motion
+        self.K = sp.csr_matrix((0, 0))
+
+    def internal_force(self, u):
+        return np.zeros(0), self.K
+
+    def commit(self, u) -> None:
+        pass
+
+    def dof_coordinates(self):
+        return np.zeros((0, 2))
+
+
+def pointwise(name: str, value, pts: np.ndarray, allow_negative: bool = True) -> np.ndarray:
+    """A float or callable x -> values (None = 0), evaluated at the points (n, 2)."""
+    if value is None:
+        return np.zeros(len(pts))
+    if callable(value):
+        v = np.asarray(value(pts), dtype=float).reshape(-1)
+        if v.shape != (len(pts),):
+            raise ValueError(f"{name}(x) must return one value per point, got {v.shape}")
+    else:
+        try:
+            v = np.full(len(pts), float(value))
+        except (TypeError, ValueError):
+            raise ValueError(f"{name} must be a float or a callable, got {value!r}") from None
+    if not np.all(np.isfinite(v)):
+        raise ValueError(f"{name} must be finite on Gamma_C")
+    if not allow_negative and np.any(v < 0):
+        raise ValueError(f"{name} must be >= 0 on Gamma_C, got min {v.min()!r}")
+    return v
+
+
+def as_body(body, name: str = "body"):
+    """The contact body of an :class:`ElasticBody` (FE), a :class:`LameBEM` (BE), or a
+    body object already (FEBody, BEBody, RigidObstacle or any object with ``kind``)."""
     if isinstance(body, ElasticBody):
-        return FEBodyAdapter(body)
+        return FEBody(body)
     if isinstance(body, LameBEM):
-        return BEBodyAdapter(body)
-    raise ValueError(f"body must be an ElasticBody or a LameBEM, got {type(body).__name__}")
+        return BEBody(body)
+    if hasattr(body, "kind") and hasattr(body, "internal_force"):
+        return body
+    raise ValueError(f"{name} must be an ElasticBody, a LameBEM or a contact body, got "
+                     f"{type(body).__name__}")
