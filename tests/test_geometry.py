@@ -100,3 +100,48 @@ def test_bad_degrees_and_marks():
         BoundaryMesh.polygon(SQUARE, n=1, p=1.5)
     with pytest.raises(ValueError, match="labels"):
         BoundaryMesh.polygon(SQUARE, n=1, labels=["D", "N"])
+
+
+def test_refine_records_parent_and_ancestor_map():
+    m = BoundaryMesh.polygon(SQUARE, n=2, labels=["D", "N", "I", "C"])
+    r = m.refine([1, 6])
+    assert r.parent_mesh is m and m.parent is None
+    assert list(r.parent) == [0, 1, 1, 2, 3, 4, 5, 6, 6, 7]
+    # every element lies in its parent
+    mid = 0.5 * (r.a + r.b)
+    assert np.array_equal(m.locate(mid)[0], r.parent)
+    rr = r.refine([0]).with_degrees(3)
+    assert np.array_equal(rr.ancestor_map(m), [0, 0, 1, 1, 2, 3, 4, 5, 6, 6, 7])
+    assert rr.ancestor_map(BoundaryMesh.polygon(SQUARE, n=2)) is None
+    assert np.array_equal(m.ancestor_map(m), np.arange(8))
+
+
+def test_locate_points_on_the_boundary():
+    m = BoundaryMesh.polygon(SQUARE, n=2)
+    e, t = m.locate(np.array([[0.25, 0.0], [1.0, 0.75], [0.5, 0.5], [0.0, 0.0]]))
+    assert list(e[:2]) == [0, 3] and np.allclose(t[:2], [0.0, 0.0])
+    assert e[2] == -1 and np.isnan(t[2])
+    assert e[3] == 0 and t[3] == -1.0          # a vertex: the first element containing it
+    with pytest.raises(ValueError, match="points"):
+        m.locate(np.zeros(3))
+
+
+def test_common_refinement_of_nested_meshes():
+    from hpfebe.geometry import common_refinement
+
+    labels = ["C", "C", "D", "C"]
+    sq = [(-1, -1), (1, -1), (1, 1), (-1, 1)]
+    base = BoundaryMesh.polygon(sq, n=8, labels=labels)
+    adaptive = BoundaryMesh.polygon(sq, n=4, labels=labels).refine([0, 5]).refine([0])
+    c = common_refinement(base, adaptive)
+    assert c.n_elements == 33                          # one extra node at x = -0.875
+    assert np.allclose(c.nodes[:3], [[-1, -1], [-0.875, -1], [-0.75, -1]])
+    assert np.all(c.elements[1:, 0] == c.elements[:-1, 1])
+    assert np.array_equal(c.labels, base.labels[base.locate(0.5 * (c.a + c.b))[0]])
+    # the same mesh: nothing changes; degrees: the largest of the containing elements
+    assert common_refinement(base, base).n_elements == 32
+    assert np.all(common_refinement(base, base.with_degrees(3)).degrees == 3)
+    with pytest.raises(ValueError, match="same boundary"):
+        common_refinement(base, BoundaryMesh.polygon(SQUARE, n=2))
+    with pytest.raises(ValueError, match="labels"):
+        common_refinement(base, BoundaryMesh.polygon(sq, n=4, labels="C"))

@@ -19,7 +19,8 @@ import pytest
 from scipy.linalg import null_space
 
 from hpfebe import BoundaryMesh
-from hpfebe.bem.lame import LameBEM, lame_constants, local_blocks
+from hpfebe.bem.lame import LameBEM, local_blocks
+from hpfebe.materials import lame_constants
 from hpfebe.quadrature import gauss_legendre, gauss_lobatto
 from hpfebe.spaces import lagrange_values, legendre_values
 

@@ -72,3 +72,48 @@ def test_evaluate_bad_coeffs():
     V = ContinuousSpace(m)
     with pytest.raises(ValueError, match="coeffs"):
         V.evaluate(np.zeros(3), [0], [0.0])
+
+
+@pytest.mark.parametrize("Space", [ContinuousSpace, DiscontinuousSpace])
+def test_trace_matrix_equals_evaluate(Space):
+    m = mixed_mesh()
+    S = Space(m)
+    rng = np.random.default_rng(0)
+    c = rng.standard_normal((S.ndof, 2))
+    elem = rng.integers(0, m.n_elements, 40)
+    t = rng.uniform(-1, 1, 40)
+    t[:3] = [-1.0, 1.0, 0.0]
+    A = S.trace_matrix(elem, t)
+    assert A.shape == (40, S.ndof)
+    assert np.allclose(A @ c[:, 0], S.evaluate(c[:, 0], elem, t), atol=1e-12)
+    A2 = S.trace_matrix(elem, t, components=2)
+    assert A2.shape == (80, 2 * S.ndof)
+    assert np.allclose((A2 @ c.ravel()).reshape(-1, 2), S.evaluate(c, elem, t), atol=1e-12)
+    D = S.trace_matrix(elem, 0.9 * t, derivative=True)
+    assert np.allclose(D @ c[:, 1], S.evaluate(c[:, 1], elem, 0.9 * t, derivative=True),
+                       atol=1e-9)
+
+
+def test_trace_matrix_drops_removed_dofs_and_checks_input():
+    m = mixed_mesh()
+    Vd = ContinuousSpace(m, zero_on=("D",))
+    on_d = np.flatnonzero(m.where("D"))
+    A = Vd.trace_matrix(on_d, np.zeros(len(on_d)))
+    assert A.nnz == 0                   # p = 1 on Gamma_D: every function there removed
+    with pytest.raises(ValueError, match="components"):
+        Vd.trace_matrix([0], [0.0], components=3)
+    with pytest.raises(ValueError, match="elem"):
+        Vd.trace_matrix([m.n_elements], [0.0])
+    with pytest.raises(ValueError, match="t must"):
+        Vd.trace_matrix([0], [1.5])
+
+
+def test_free_dofs():
+    m = mixed_mesh()
+    V = ContinuousSpace(m)
+    free = V.free_dofs()
+    assert np.array_equal(free, np.setdiff1d(np.arange(V.ndof), V.dofs_on("D")))
+    assert len(free) == ContinuousSpace(m, zero_on=("D",)).ndof
+    f2 = V.free_dofs(components=2)
+    assert np.array_equal(f2[0::2], 2 * free) and np.array_equal(f2[1::2], 2 * free + 1)
+    assert np.array_equal(V.free_dofs("D", "I"), np.setdiff1d(free, V.dofs_on("I")))

@@ -77,6 +77,9 @@ class BoundaryMesh:
     elements : (ne, 2) int array of node indices (direction = orientation)
     labels : (ne,) str array, one label per element
     degrees : (ne,) int array, polynomial degree p_I >= 1 of each element
+    parent : (ne,) int array or None; set by :meth:`refine` and :meth:`with_degrees`:
+        ``parent[k]`` is the element of ``parent_mesh`` that contains element k
+    parent_mesh : the mesh this one was refined from (None for a built mesh)
     """
 
     nodes: np.ndarray
@@ -84,6 +87,8 @@ class BoundaryMesh:
     labels: np.ndarray
     degrees: np.ndarray
     _checked: bool = field(default=False, repr=False)
+    parent: np.ndarray | None = field(default=None, repr=False)
+    parent_mesh: "BoundaryMesh | None" = field(default=None, repr=False)
 
     def __post_init__(self):
         nodes = np.ascontiguousarray(self.nodes, dtype=float)
@@ -94,6 +99,15 @@ class BoundaryMesh:
                           ("degrees", degrees)):
             arr.setflags(write=False)
             object.__setattr__(self, name, arr)
+        if (self.parent is None) != (self.parent_mesh is None):
+            raise ValueError("parent and parent_mesh must be given together")
+        if self.parent is not None:
+            parent = np.ascontiguousarray(self.parent, dtype=np.int64)
+            if parent.shape != (len(elements),):
+                raise ValueError(f"parent must have one entry per element ({len(elements)}),"
+                                 f" got shape {parent.shape}")
+            parent.setflags(write=False)
+            object.__setattr__(self, "parent", parent)
         if not self._checked:
             self._validate()
 
@@ -287,10 +301,43 @@ class BoundaryMesh:
         """Boolean mask of the elements carrying any of ``labels``."""
         return np.isin(self.labels, labels)
 
+    @property
+    def scale(self) -> float:
+        """Largest coordinate extent of the used nodes (the length scale of tolerances)."""
+        used = self.nodes[np.unique(self.elements)]
+        return max(float(np.ptp(used, axis=0).max()), np.finfo(float).tiny)
+
+    def locate(self, points, tol: float = 5e-11, chunk: int = 2048):
+        """Element and reference coordinate of points lying on the boundary.
+
+        Returns ``(elem, t)``: for each point the element nearest to it (the first one on
+        ties, e.g. at a vertex) and ``t`` in [-1, 1] of the nearest point on it; ``elem``
+        is -1 (and ``t`` NaN) for points farther than ``tol * scale`` from the mesh."""
+        pts = np.asarray(points, dtype=float)
+        if pts.ndim != 2 or pts.shape[1] != 2:
+            raise ValueError(f"points must have shape (n, 2), got {pts.shape}")
+        if not (np.isfinite(tol) and tol >= 0):
+            raise ValueError(f"tol must be finite and >= 0, got {tol!r}")
+        a, ab = self.a, self.b - self.a
+        L2 = np.sum(ab ** 2, 1)
+        elem = np.full(len(pts), -1, dtype=np.int64)
+        t = np.full(len(pts), np.nan)
+        for i0 in range(0, len(pts), chunk):
+            p = pts[i0:i0 + chunk]
+            d = p[:, None, :] - a[None, :, :]                       # (m, ne, 2)
+            s = np.clip(np.einsum("mek,ek->me", d, ab) / L2, 0.0, 1.0)
+            dist = np.linalg.norm(d - s[..., None] * ab, axis=2)
+            e = np.argmin(dist, axis=1)
+            rows = np.arange(len(p))
+            on = dist[rows, e] <= tol * self.scale
+            elem[i0:i0 + chunk] = np.where(on, e, -1)
+            t[i0:i0 + chunk] = np.where(on, 2.0 * s[rows, e] - 1.0, np.nan)
+        return elem, t
+
     # ------------------------------------------------------------------ refinement
     def _replace(self, **kw) -> "BoundaryMesh":
         args = dict(nodes=self.nodes, elements=self.elements, labels=self.labels,
-                    degrees=self.degrees, _checked=True)
+                    degrees=self.degrees, _checked=True, parent=None, parent_mesh=None)
         args.update(kw)
         return BoundaryMesh(**args)
 
@@ -311,7 +358,9 @@ class BoundaryMesh:
 
     def refine(self, marked=None) -> "BoundaryMesh":
         """Bisect the marked elements (all if ``marked`` is None); labels and degrees are
-        inherited, element order along the curves is kept."""
+        inherited, element order along the curves is kept.  The refined mesh carries
+        ``parent`` (the element of this mesh each new element came from) and
+        ``parent_mesh`` (this mesh)."""
         mask = self._marked(marked)
         ne, nn = self.n_elements, len(self.nodes)
         mid_idx = nn + np.cumsum(mask) - 1
@@ -325,15 +374,93 @@ class BoundaryMesh:
         el[split & first, 1] = mid_idx[parent[split & first]]
         el[split & ~first, 0] = mid_idx[parent[split & ~first]]
         return self._replace(nodes=new_nodes, elements=el, labels=self.labels[parent],
-                             degrees=self.degrees[parent])
+                             degrees=self.degrees[parent], parent=parent, parent_mesh=self)
 
     def with_degrees(self, p) -> "BoundaryMesh":
-        """The same mesh with degree ``p`` (scalar or per element)."""
+        """The same mesh with degree ``p`` (scalar or per element); its ``parent`` is the
+        identity map into this mesh."""
         p = np.broadcast_to(np.asarray(p), (self.n_elements,)).astype(np.int64)
         if p.min() < 1:
             raise ValueError(f"degree p must be >= 1, got {p.min()}")
-        return self._replace(degrees=p.copy())
+        return self._replace(degrees=p.copy(), parent=np.arange(self.n_elements),
+                             parent_mesh=self)
+
+    def ancestor_map(self, ancestor: "BoundaryMesh") -> np.ndarray | None:
+        """For each element, the element of ``ancestor`` containing it, by composing the
+        ``parent`` maps up the chain of refinements; None if ``ancestor`` is not in the
+        chain (then use geometry, e.g. :func:`hpfebe.spaces.prolongate`)."""
+        m, idx = self, np.arange(self.n_elements)
+        while m is not ancestor:
+            if m.parent is None:
+                return None
+            idx = m.parent[idx]
+            m = m.parent_mesh
+        return idx
 
     def raise_degree(self, marked=None, by: int = 1) -> "BoundaryMesh":
         """Raise the degree of the marked elements by ``by``."""
         return self.with_degrees(self.degrees + by * self._marked(marked))
+
+
+def common_refinement(*meshes: BoundaryMesh, tol: float = 5e-11) -> BoundaryMesh:
+    """The coarsest mesh refining all given meshes of one boundary.
+
+    The elements of the first mesh are split at every node of the others lying inside
+    them (element order, orientation and labels of the first mesh; each new element
+    gets the largest degree of the elements containing it, so that every mesh's spaces
+    embed in its own).  ValueError if the meshes do not cover the same boundary or
+    disagree on a label."""
+    if not meshes:
+        raise ValueError("meshes: give at least one mesh")
+    for k, m in enumerate(meshes):
+        if not isinstance(m, BoundaryMesh):
+            raise ValueError(f"meshes[{k}] must be a BoundaryMesh, got {type(m).__name__}")
+    base = meshes[0]
+    # every mesh's nodes lie on every other mesh (same boundary)
+    for k, m in enumerate(meshes):
+        for j, other in enumerate(meshes):
+            if j != k and np.any(other.locate(m.nodes[np.unique(m.elements)], tol)[0] < 0):
+                raise ValueError(f"meshes: a node of mesh {k} does not lie on mesh {j} "
+                                 "(not the same boundary)")
+    # points inside the base elements where another mesh has a node
+    pts = np.vstack([m.nodes[np.unique(m.elements)] for m in meshes[1:]] or
+                    [np.zeros((0, 2))])
+    e, t = base.locate(pts, tol)
+    s = 0.5 * (t + 1.0)
+    inner = (s * base.lengths[e] > tol * base.scale) & \
+        ((1.0 - s) * base.lengths[e] > tol * base.scale)
+    e, s, pts = e[inner], s[inner], pts[inner]
+    order = np.lexsort((s, e))
+    e, s, pts = e[order], s[order], pts[order]
+    # drop repeated points (the same node in several meshes)
+    keep = np.ones(len(e), dtype=bool)
+    keep[1:] = (e[1:] != e[:-1]) | ((s[1:] - s[:-1]) * base.lengths[e[1:]] > tol * base.scale)
+    e, pts = e[keep], pts[keep]
+    # new elements, in base element order: start node of each, then the interior ones
+    nb = base.n_elements
+    counts = np.bincount(e, minlength=nb) + 1
+    owner = np.repeat(np.arange(nb), counts)
+    first = np.concatenate([[0], np.cumsum(counts)[:-1]])
+    starts = np.empty((len(owner), 2))
+    starts[first] = base.a
+    is_inner = np.ones(len(owner), dtype=bool)
+    is_inner[first] = False
+    starts[is_inner] = pts
+    # node numbering by first appearance as a start point; an element ends where the next
+    # element of its base element starts, or at the base element's end node
+    is_last = np.zeros(len(owner), dtype=bool)
+    is_last[np.append(first[1:], len(owner)) - 1] = True
+    start_id = np.arange(len(owner))
+    base_start_id = np.zeros(len(base.nodes), dtype=np.int64)
+    base_start_id[base.elements[:, 0]] = first
+    end_id = np.where(is_last, base_start_id[base.elements[owner, 1]], start_id + 1)
+    seg = np.column_stack([start_id, end_id])
+    mid = 0.5 * (starts + starts[end_id])
+    labels = base.labels[owner]
+    degrees = base.degrees[owner].copy()
+    for k, m in enumerate(meshes[1:], start=1):
+        em, _ = m.locate(mid, tol)
+        if np.any(m.labels[em] != labels):
+            raise ValueError(f"meshes: mesh {k} has other boundary labels than mesh 0")
+        degrees = np.maximum(degrees, m.degrees[em])
+    return BoundaryMesh(starts, seg, labels, degrees)

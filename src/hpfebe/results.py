@@ -11,7 +11,14 @@ Every file is written atomically (temporary file in the same directory, fsync,
 ``os.replace``): an interrupted run never leaves a half-written file under the final
 name.  The JSON file is written last, so a result is complete when its JSON exists.
 
-This is an edge module: no numerics, only data containers and file writing.
+Claims that recur are built by helpers, so that the verdict and its evidence read the
+same everywhere: :func:`rate_claim` (an observed rate against the expected one),
+:func:`beats_uniform_claim` (adaptive against uniform refinement at equal DOF) and
+:func:`range_claim` (a computed range against a published one, e.g. a colorbar).
+
+This is an edge module: no numerics (the log-log interpolation is
+:func:`hpfebe.analysis.rates.loglog_interpolate`), only data containers, claims and
+file writing.
 """
 
 from __future__ import annotations
@@ -34,6 +41,9 @@ import pandas as pd
 
 __all__ = [
     "Claim",
+    "rate_claim",
+    "beats_uniform_claim",
+    "range_claim",
     "ArtefactResult",
     "write_result",
     "read_result",
@@ -64,6 +74,78 @@ class Claim:
     text: str
     holds: bool | None
     evidence: str = ""
+
+
+def _finite(name: str, v) -> float:
+    try:
+        x = float(v)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} must be a number, got {v!r}") from None
+    if not math.isfinite(x):
+        raise ValueError(f"{name} must be finite, got {v!r}")
+    return x
+
+
+def rate_claim(statement: str, observed: float, expected: float, tol: float,
+               what: str = "rate") -> Claim:
+    """Holds iff |observed - expected| <= tol (a NaN observation does not hold)."""
+    expected, tol = _finite("expected", expected), _finite("tol", tol)
+    if tol < 0:
+        raise ValueError(f"tol must be >= 0, got {tol!r}")
+    observed = float(observed)
+    holds = bool(abs(observed - expected) <= tol)
+    return Claim(statement, holds, f"observed {what} {observed:.3f}, expected {expected:.4g} "
+                                   f"+- {tol:g}")
+
+
+def beats_uniform_claim(statement: str, dof_adaptive, err_adaptive, dof_uniform,
+                        err_uniform, factor: float = 1.0) -> Claim:
+    """Adaptive against uniform refinement at equal DOF: holds iff the last adaptive
+    error is below ``factor`` x the uniform error log-log interpolated at the last
+    adaptive DOF; not decidable (holds None) if the uniform DOF range does not contain
+    that DOF."""
+    from .analysis.rates import loglog_interpolate
+
+    factor = _finite("factor", factor)
+    if factor <= 0:
+        raise ValueError(f"factor must be > 0, got {factor!r}")
+    dof_a, err_a = np.asarray(dof_adaptive, float), np.asarray(err_adaptive, float)
+    dof_u = np.asarray(dof_uniform, float)
+    if dof_a.size == 0 or dof_a.shape != err_a.shape:
+        raise ValueError(f"dof_adaptive and err_adaptive must be non-empty and of equal "
+                         f"length, got {dof_a.shape}, {err_a.shape}")
+    d, e = float(dof_a[-1]), float(err_a[-1])
+    head = f"last adaptive step: {d:.0f} DOF, error {e:.4g}"
+    if dof_u.size == 0 or not dof_u.min() <= d <= dof_u.max():
+        rng = f"{dof_u.min():.0f}..{dof_u.max():.0f}" if dof_u.size else "none"
+        return Claim(statement, None, f"{head}; the uniform DOF range ({rng}) does not "
+                                      "contain it: not decidable")
+    e_u = loglog_interpolate(d, dof_u, err_uniform)
+    cond = f"below {factor:g} x uniform" if factor != 1.0 else "below uniform"
+    return Claim(statement, bool(e < factor * e_u),
+                 f"{head}; uniform at that DOF (log-log interpolated) {e_u:.4g}; ratio "
+                 f"{e / e_u:.3f} (holds if {cond})")
+
+
+def range_claim(statement: str, name: str, ours, published, rel_tol: float) -> Claim:
+    """A computed range ``ours = (lo, hi)`` against a published one: holds iff both ends
+    deviate by at most ``rel_tol`` x |published span|."""
+    rel_tol = _finite("rel_tol", rel_tol)
+    if rel_tol < 0:
+        raise ValueError(f"rel_tol must be >= 0, got {rel_tol!r}")
+    try:
+        lo, hi = (_finite(f"ours[{i}]", v) for i, v in enumerate(ours))
+        plo, phi = (_finite(f"published[{i}]", v) for i, v in enumerate(published))
+    except (TypeError, ValueError) as err:
+        raise ValueError(f"ours and published must be (lo, hi) pairs: {err}") from None
+    span = abs(phi - plo)
+    if span == 0:
+        raise ValueError(f"published range must have a non-zero span, got {published!r}")
+    dev = max(abs(lo - plo), abs(hi - phi)) / span
+    return Claim(statement, bool(dev <= rel_tol),
+                 f"{name} {lo:.4e}..{hi:.4e} (published {plo:.4e}..{phi:.4e}): largest "
+                 f"deviation {100 * dev:.1f} % of the published span (tolerance "
+                 f"{100 * rel_tol:g} %)")
 
 
 @dataclass

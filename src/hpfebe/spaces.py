@@ -86,14 +86,23 @@ def eval_basis(kind, p, t, gll_x, gll_b, out):
 
 def lagrange_values(p: int, t: np.ndarray, derivative: bool = False) -> np.ndarray:
     """GLL Lagrange basis of degree p at points t, shape (len(t), p+1) (numpy)."""
-    xp, _ = gauss_lobatto(p + 1)
     t = np.atleast_1d(np.asarray(t, dtype=float))
+    coef = _lagrange_legendre_coef(int(p), bool(derivative))
+    return npleg.legvander(t, coef.shape[0] - 1) @ coef
+
+
+@lru_cache(maxsize=None)
+def _lagrange_legendre_coef(p: int, derivative: bool) -> np.ndarray:
+    """Legendre coefficients of the GLL Lagrange polynomials l_j (column j) of degree p,
+    or of their derivatives."""
+    xp, _ = gauss_lobatto(p + 1)
     # coefficients of each l_j in the Legendre basis by exact interpolation at the nodes
     vand = npleg.legvander(xp, p)
     coef = np.linalg.solve(vand, np.eye(p + 1))  # column j: Legendre coeffs of l_j
     if derivative:
         coef = npleg.legder(coef, axis=0)
-    return npleg.legvander(t, coef.shape[0] - 1) @ coef
+    coef.setflags(write=False)
+    return coef
 
 
 def legendre_values(p: int, t: np.ndarray, derivative: bool = False) -> np.ndarray:
@@ -101,8 +110,10 @@ def legendre_values(p: int, t: np.ndarray, derivative: bool = False) -> np.ndarr
     t = np.atleast_1d(np.asarray(t, dtype=float))
     coef = np.eye(p)
     if derivative:
-        return npleg.legvander(t, p - 1) @ np.vstack([npleg.legder(coef, axis=0),
-                                                      np.zeros((1, p))])
+        der = np.zeros((p, p))
+        d = npleg.legder(coef, axis=0)      # (max(p - 1, 1), p): a constant's is [0]
+        der[:p - 1] = d[:p - 1]
+        return npleg.legvander(t, p - 1) @ der
     return npleg.legvander(t, p - 1)
 
 
@@ -118,6 +129,46 @@ class _Space:
 
     def _values(self, p: int, t, derivative=False):
         raise NotImplementedError
+
+    def trace_matrix(self, elem, t, components: int = 1,
+                     derivative: bool = False) -> sp.csr_matrix:
+        """Sparse matrix of the basis values (or arc-length derivatives d/ds) at the points
+        of reference coordinates ``t[i]`` (in [-1, 1]) on the elements ``elem[i]``.
+
+        ``components=1``: shape (n, ndof), entry [i, dof].  ``components=2``: the
+        interleaved vector version (row 2 i + c, column 2 dof + c), shape (2n, 2 ndof),
+        so that ``trace_matrix(elem, t, 2) @ U`` are the interleaved values of U in
+        V_hp^2 (or W_hp^2)."""
+        if components not in (1, 2):
+            raise ValueError(f"components must be 1 or 2, got {components!r}")
+        elem = np.atleast_1d(np.asarray(elem))
+        if elem.ndim != 1 or (elem.size and not np.issubdtype(elem.dtype, np.integer)):
+            raise ValueError("elem must be a 1D array of element indices")
+        ne = self.mesh.n_elements
+        if elem.size and (elem.min() < 0 or elem.max() >= ne):
+            raise ValueError(f"elem must lie in 0..{ne - 1}")
+        t = np.broadcast_to(np.asarray(t, dtype=float), elem.shape)
+        if t.size and np.max(np.abs(t)) > 1.0 + 1e-12:
+            raise ValueError("t must lie in [-1, 1]")
+        n = len(elem)
+        rows, cols, vals = [np.zeros(0, np.int64)], [np.zeros(0, np.int64)], [np.zeros(0)]
+        degrees = self.mesh.degrees[elem]
+        for p in np.unique(degrees):
+            sel = np.flatnonzero(degrees == p)
+            phi = self._values(int(p), t[sel], derivative)          # (k, nloc)
+            if derivative:
+                phi = phi * (2.0 / self.mesh.lengths[elem[sel]])[:, None]
+            dofs = self.elem_dofs[elem[sel], :phi.shape[1]]
+            keep = dofs >= 0
+            rows.append(np.broadcast_to(sel[:, None], dofs.shape)[keep])
+            cols.append(dofs[keep])
+            vals.append(phi[keep])
+        r, c, v = np.concatenate(rows), np.concatenate(cols), np.concatenate(vals)
+        if components == 2:
+            r = np.concatenate([2 * r, 2 * r + 1])
+            c = np.concatenate([2 * c, 2 * c + 1])
+            v = np.concatenate([v, v])
+        return sp.csr_matrix((v, (r, c)), shape=(components * n, components * self.ndof))
 
     def evaluate(self, coeffs, elem, t, derivative: bool = False) -> np.ndarray:
         """Values (or arc-length derivatives d/ds) of the discrete function with
@@ -139,6 +190,18 @@ class _Space:
             if derivative:
                 v = v * (2.0 / L[elem[sel]]).reshape((-1,) + (1,) * (v.ndim - 1))
             out[sel] = v
+        return out
+
+
+    def evaluate_at(self, coeffs, points, tol: float = 5e-11) -> np.ndarray:
+        """Values of the discrete function at physical ``points`` (n, 2) lying on the
+        boundary (:meth:`BoundaryMesh.locate`); NaN rows for points not on it."""
+        coeffs = np.asarray(coeffs)
+        elem, t = self.mesh.locate(points, tol)
+        out = np.full((len(elem),) + coeffs.shape[1:], np.nan)
+        on = elem >= 0
+        if np.any(on):
+            out[on] = self.evaluate(coeffs, elem[on], t[on])
         return out
 
 
@@ -225,6 +288,18 @@ class ContinuousSpace(_Space):
         d = self.elem_dofs[on]
         return np.unique(d[d >= 0])
 
+    def free_dofs(self, *labels: str, components: int = 1) -> np.ndarray:
+        """Sorted dofs whose basis functions vanish on the (closed) elements carrying
+        ``labels`` (default the Dirichlet label "D"); for ``components=2`` the interleaved
+        vector dofs 2 d + c."""
+        if components not in (1, 2):
+            raise ValueError(f"components must be 1 or 2, got {components!r}")
+        labels = labels or ("D",)
+        free = np.setdiff1d(np.arange(self.ndof), self.dofs_on(*labels))
+        if components == 2:
+            free = np.column_stack([2 * free, 2 * free + 1]).ravel()
+        return free
+
     def interpolate(self, f) -> np.ndarray:
         """Nodal interpolant of f(x) at the Gauss-Lobatto points of each element."""
         mesh = self.mesh
@@ -276,3 +351,83 @@ class ContinuousSpace(_Space):
             vals.append(v[keep])
         return sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
                              shape=(W.ndof, self.ndof))
+
+
+def containing_elements(coarse: BoundaryMesh, fine: BoundaryMesh, tol: float = 5e-11):
+    """For each element of ``fine``, the element of ``coarse`` containing it: from the
+    ``parent`` maps when ``coarse`` is an ancestor of ``fine`` (:meth:`BoundaryMesh.refine`),
+    otherwise by locating the element midpoints.  ValueError if some fine element does not
+    lie inside one coarse element (meshes not nested)."""
+    idx = fine.ancestor_map(coarse)
+    if idx is not None:
+        return idx
+    mid = 0.5 * (fine.a + fine.b)
+    idx, _ = coarse.locate(mid, tol)
+    if np.any(idx < 0):
+        k = int(np.flatnonzero(idx < 0)[0])
+        raise ValueError(f"meshes are not nested: fine element {k} is not on the coarse "
+                         "mesh")
+    # both ends on the same coarse element (within the element, not beyond its ends)
+    for x in (fine.a, fine.b):
+        a, ab = coarse.a[idx], coarse.b[idx] - coarse.a[idx]
+        s = np.sum((x - a) * ab, 1) / np.sum(ab ** 2, 1)
+        off = np.linalg.norm(a + s[:, None] * ab - x, axis=1)
+        bad = (s < -tol) | (s > 1 + tol) | (off > tol * coarse.scale)
+        if np.any(bad):
+            k = int(np.flatnonzero(bad)[0])
+            raise ValueError(f"meshes are not nested: fine element {k} is not inside one "
+                             f"coarse element (nearest: {int(idx[k])})")
+    return idx
+
+
+def _reference_coordinates(mesh: BoundaryMesh, elem, x) -> np.ndarray:
+    """t in [-1, 1] of the points x (n, 2) on the straight elements ``elem``."""
+    a, ab = mesh.a[elem], mesh.b[elem] - mesh.a[elem]
+    return np.clip(2.0 * np.sum((x - a) * ab, 1) / np.sum(ab ** 2, 1) - 1.0, -1.0, 1.0)
+
+
+def prolongate(coarse_space: _Space, U, fine_space: _Space, components: int = 1) -> np.ndarray:
+    """Exact embedding of U (coefficients in ``coarse_space``, ``components`` interleaved)
+    into ``fine_space`` of the same kind on a nested mesh (every fine element inside one
+    coarse element, fine degree >= coarse degree).
+
+    V_hp: nodal values at the Gauss-Lobatto points of the fine elements.  W_hp: the
+    Legendre coefficients of the restriction to each fine element (Gauss rule exact for
+    the polynomial degree).  Fine dofs removed by ``zero_on`` are dropped."""
+    if components not in (1, 2):
+        raise ValueError(f"components must be 1 or 2, got {components!r}")
+    if type(coarse_space) is not type(fine_space):
+        raise ValueError("coarse_space and fine_space must be of the same kind, got "
+                         f"{type(coarse_space).__name__} and {type(fine_space).__name__}")
+    U = np.asarray(U, dtype=float)
+    if U.shape != (components * coarse_space.ndof,):
+        raise ValueError(f"U must have {components * coarse_space.ndof} entries "
+                         f"(components={components}), got shape {U.shape}")
+    mc, mf = coarse_space.mesh, fine_space.mesh
+    parent = containing_elements(mc, mf)
+    low = mf.degrees < mc.degrees[parent]
+    if np.any(low):
+        k = int(np.flatnonzero(low)[0])
+        raise ValueError(f"fine degree must be >= the coarse one: fine element {k} has "
+                         f"p = {mf.degrees[k]}, its coarse element p = {mc.degrees[parent[k]]}")
+    Uc = U.reshape(-1, components)
+    Uf = np.zeros((fine_space.ndof, components))
+    for p in np.unique(mf.degrees):
+        p = int(p)
+        els = np.flatnonzero(mf.degrees == p)
+        if fine_space.kind == LAGRANGE_GLL:
+            tq, _ = gauss_lobatto(p + 1)
+        else:
+            tq, wq = gauss_legendre(p)
+        e = np.repeat(els, len(tq))
+        tc = _reference_coordinates(mc, parent[e], mf.points(e, np.tile(tq, len(els))))
+        vals = coarse_space.evaluate(Uc, parent[e], tc).reshape(len(els), len(tq), components)
+        if fine_space.kind == LAGRANGE_GLL:
+            coef = vals                                             # nodal values
+        else:
+            P = legendre_values(p, tq)                              # (nq, p)
+            k = np.arange(p)
+            coef = np.einsum("q,qk,eqc->ekc", wq, P, vals) * ((2 * k + 1) / 2.0)[:, None]
+        d = fine_space.elem_dofs[els, :coef.shape[1]]
+        Uf[d[d >= 0]] = coef[d >= 0]
+    return Uf.ravel()

@@ -5,8 +5,10 @@
 * :mod:`.bem_estimator` - residual BE indicator (3.107), error measure (3.105), Laplace
   and Lame.
 * :mod:`.fe_estimator` - residual FE indicator (3.100), error measure (3.99), P1/Q1,
-  Poisson and linear elasticity.
-* :mod:`.adaptive` - the loop of Algorithm 3.2.
+  Poisson and linear elasticity; the indicators of two FE bodies in contact with the
+  contact datum on Gamma_C.
+* :mod:`.adaptive` - the loop of Algorithm 3.2, for one mesh or several (one marking
+  per mesh), with the marked elements of every step in its history.
 """
 
 from .adaptive import AdaptiveHistory, adapt, default_refine
@@ -15,11 +17,13 @@ from .bem_estimator import (bem_indicators, boundary_residuals, error_measure_B,
                             lame_boundary_residuals, solve_lame_mixed, solve_laplace_mixed)
 from .fe_estimator import energy_error as fe_energy_error
 from .fe_estimator import energy_error_elasticity as fe_energy_error_elasticity
-from .fe_estimator import fe_indicators, lame_stress
+from .fe_estimator import (contact_traction_datum, fe_indicators, hooke_stress, lame_stress,
+                           two_body_indicators)
 from .marking import mark_bulk, mark_doerfler, mark_max
 
 __all__ = ["AdaptiveHistory", "adapt", "default_refine", "bem_indicators",
            "boundary_residuals", "error_measure_B", "solve_laplace_mixed",
            "error_measure_B_lame", "lame_bem_indicators", "lame_boundary_residuals",
            "solve_lame_mixed", "fe_energy_error", "fe_energy_error_elasticity",
-           "fe_indicators", "lame_stress", "mark_bulk", "mark_doerfler", "mark_max"]
+           "fe_indicators", "lame_stress", "hooke_stress", "contact_traction_datum",
+           "two_body_indicators", "mark_bulk", "mark_doerfler", "mark_max"]

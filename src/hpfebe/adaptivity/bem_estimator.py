@@ -92,11 +92,10 @@ def solve_laplace_mixed(op, flux, dirichlet=("D",)):
     S_hat U = t_hat weakly on the rest.  ``flux(x, n)`` is the Neumann datum t_hat (its
     values on Gamma_D are not used).  Returns (U, Psi)."""
     V = op.V_space
-    fixed = V.dofs_on(*dirichlet)
-    if fixed.size == 0:
+    if not np.any(op.mesh.where(*dirichlet)):
         raise ValueError(f"dirichlet labels {dirichlet!r} select no element: the pure "
                          "Neumann problem is not handled here")
-    free = np.setdiff1d(np.arange(V.ndof), fixed)
+    free = V.free_dofs(*dirichlet)
     F = neumann_functional(V, flux)
     U = np.zeros(V.ndof)
     U[free] = sla.solve(op.S_hat[np.ix_(free, free)], F[free], assume_a="pos")
@@ -208,20 +207,15 @@ def lame_boundary_residuals(op, U, Psi, nq: int | None = None, delta: float = 1e
                 SU=SU, dres=dres)
 
 
-def _lame_dofs(scalar_dofs):
-    d = np.asarray(scalar_dofs)
-    return np.column_stack([2 * d, 2 * d + 1]).ravel()
-
-
 def solve_lame_mixed(op, traction, dirichlet=("D",), u_dirichlet=None):
     """Primal Lame BEM: U in V_hp^2 with U = I_h u_dirichlet (default 0) on the
     ``dirichlet`` elements, S_hat U = t_hat weakly on the rest; ``traction(x, n)`` returns
     (n, 2).  Returns (U, Psi), interleaved."""
     Vs = op.V_space
-    fixed = _lame_dofs(Vs.dofs_on(*dirichlet))
-    if fixed.size == 0:
+    if not np.any(op.mesh.where(*dirichlet)):
         raise ValueError(f"dirichlet labels {dirichlet!r} select no element")
-    free = np.setdiff1d(np.arange(2 * Vs.ndof), fixed)
+    free = Vs.free_dofs(*dirichlet, components=2)
+    fixed = np.setdiff1d(np.arange(2 * Vs.ndof), free)
     F = np.column_stack([neumann_functional(Vs, lambda x, n, c=c: traction(x, n)[:, c])
                          for c in range(2)]).ravel()
     U = np.zeros(2 * Vs.ndof)
@@ -264,3 +258,95 @@ def error_measure_B_lame(op, U, Psi, u_exact, traction_exact, extra: int = 3) ->
     eu = interpolation_difference(op.V_space, hi.V_space, np.asarray(U).reshape(-1, 2),
                                   lambda x, n: u_exact(x)).ravel()
     return float(np.sqrt(max(eu @ hi.W @ eu, 0.0) + max(ep @ hi.V @ ep, 0.0)))
+
+
+# ----------------------------------------------------------------------------- contact
+# Contact part of (3.107) (Section 3.3.5): on Gamma_C the datum of the traction residual
+# is the penalty traction on the body, P_n n + P_t t = -p_n n - t_t t, evaluated from U at
+# the indicator's quadrature points with the one law of :mod:`hpfebe.contact.laws`
+# (penetration U_n - g, tangential displacement U_t against a fixed obstacle).
+
+INDICATOR_VARIANTS = ("literal", "balanced")
+
+
+def contact_traction(op, U, gap, eps_n: float, eps_t: float, mu_f=None, F=None, slip=0.0):
+    """The datum P_n n + P_t t of (3.107) as ``f(x, n, elem, t) -> (n, 2)``: the traction
+    -p_n n - t_t t of :func:`hpfebe.contact.laws.penalty_friction` on the body, from U
+    (V_hp^2, interleaved) at the given points; ``gap(x)`` the gap function (constraint
+    U_n <= g), Coulomb (``mu_f``) or Tresca (``F``), ``slip`` the accumulated slip (0:
+    one load step)."""
+    from ..contact.laws import penalty_friction, positive
+
+    positive("eps_n", eps_n)
+    positive("eps_t", eps_t)
+    if not callable(gap):
+        raise ValueError(f"gap must be a callable g(x), got {type(gap).__name__}")
+    Ul = np.asarray(U, dtype=float).reshape(-1, 2)
+    mesh = op.mesh
+
+    def f(x, n, elem, t):
+        u = op.V_space.evaluate(Ul, elem, t)
+        nn, tt = mesh.normals[elem], mesh.tangents[elem]
+        law = penalty_friction(np.sum(u * nn, 1) - gap(x), np.sum(u * tt, 1), slip,
+                               eps_n, eps_t, mu_f=mu_f, F=F)
+        return -law.p_n[:, None] * nn - law.t_t[:, None] * tt
+    return f
+
+
+def consistency_weight(variant: str, E: float, nu: float, plane: str = "strain") -> float:
+    """Weight of the consistency term h_I ||d/ds (V Psi - (K + 1/2) U)||^2 of (3.107) for
+    Lame: "literal" 1 (the thesis's formula, a strain beside a traction), "balanced"
+    E' (:func:`hpfebe.materials.plane_modulus`), which gives both terms the units of
+    (traction x length)^2."""
+    from ..materials import plane_modulus
+
+    if variant == "literal":
+        return 1.0
+    if variant == "balanced":
+        return plane_modulus(E, nu, plane)
+    raise ValueError(f"indicator variant must be one of {INDICATOR_VARIANTS}, got "
+                     f"{variant!r}")
+
+
+def lame_contact_indicators(op, U, Psi, gap, eps_n: float, eps_t: float, mu_f=None, F=None,
+                            weight: float = 1.0, contact_label: str = "C",
+                            tractions: dict | None = None, nq: int | None = None):
+    """eta_h(I) of (3.107) for a Lame BEM body in penalty contact with a rigid obstacle:
+    (h_I ||P_n n + P_t t - S_hat U||^2 + weight^2 h_I ||d/ds (V Psi - (K + 1/2) U)||^2)^(1/2)
+    with the datum of :func:`contact_traction` on ``contact_label`` and further data
+    ``tractions`` (label -> callable, e.g. t_hat on "N")."""
+    weight = float(weight)
+    if not (np.isfinite(weight) and weight > 0):
+        raise ValueError(f"weight must be finite and positive, got {weight!r}")
+    data = dict(tractions or {})
+    data[contact_label] = contact_traction(op, U, gap, eps_n, eps_t, mu_f=mu_f, F=F)
+    _, parts = lame_bem_indicators(op, U, Psi, data, nq=nq, return_parts=True)
+    return np.sqrt(parts["traction"] ** 2 + (weight * parts["consistency"]) ** 2)
+
+
+def norm_B(op, U, Psi, eps_n: float = 0.0, eps_t: float = 0.0, weights=None, p_n=None,
+           t_t=None) -> float:
+    """|||U|||_B of (3.105) of a discrete penalty solution: (<W U, U> + <V Psi, Psi>
+    + eps_n ||p_n||^2_{L2(Gamma_C)} + eps_t ||t_t||^2_{L2(Gamma_C)})^(1/2), the penalty
+    terms by the quadrature ``weights`` at the contact points (none if not given)."""
+    U = np.asarray(U, dtype=float)
+    Psi = np.asarray(Psi, dtype=float)
+    n2 = U @ op.W @ U + Psi @ op.V @ Psi
+    if weights is not None:
+        w = np.asarray(weights, dtype=float)
+        n2 = n2 + eps_n * w @ np.asarray(p_n) ** 2 + eps_t * w @ np.asarray(t_t) ** 2
+    return float(np.sqrt(n2))
+
+
+def true_error(op, U, Psi, ref_op, U_ref, Psi_ref) -> float:
+    """|||U_ref - U|||_B without the penalty terms, (<W e_u, e_u> + <V e_psi, e_psi>)^(1/2)
+    with the operators of ``ref_op``, whose mesh must refine that of ``op`` (the discrete
+    (U, Psi), interleaved V_hp^2 x W_hp^2, embed exactly:
+    :func:`hpfebe.spaces.prolongate`)."""
+    from ..spaces import prolongate
+
+    Uf = prolongate(op.V_space, U, ref_op.V_space, components=2)
+    Pf = prolongate(op.W_space, Psi, ref_op.W_space, components=2)
+    eu = np.asarray(U_ref, dtype=float) - Uf
+    ep = np.asarray(Psi_ref, dtype=float) - Pf
+    return float(np.sqrt(max(eu @ ref_op.W @ eu, 0.0) + max(ep @ ref_op.V @ ep, 0.0)))

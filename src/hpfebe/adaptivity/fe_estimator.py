@@ -16,6 +16,13 @@ thesis's h-adaptive FE examples are low order).
 
 Error measure (3.99) without penalty terms: |||u - U|||_F^2 = a(u - U, u - U) =
 || grad (u - U) ||^2_{L2(Omega)} for Poisson, see :func:`energy_error`.
+
+Two bodies in contact (Section 4.2.8, :func:`two_body_indicators`): each body gets its
+own indicator (3.100); the datum on Gamma_C ("P_n n + P_t t") is the discrete penalty
+traction on the slave, p_n n_m - t_t t_m at the slave contact points (sign convention of
+:mod:`hpfebe.contact.two_body`), interpolated linearly along a straight interface
+(:func:`contact_traction_datum`), and its negative on the master at the same interface
+coordinate.
 """
 
 from __future__ import annotations
@@ -24,15 +31,8 @@ import numpy as np
 from skfem import Basis, ElementQuad1, ElementTriP1, FacetBasis, Functional, InteriorFacetBasis
 from skfem.helpers import grad
 
-
-def _cell_diameter(mesh) -> np.ndarray:
-    p, t = mesh.p, mesh.t
-    nv = t.shape[0]
-    h = np.zeros(t.shape[1])
-    for i in range(nv):
-        for j in range(i + 1, nv):
-            h = np.maximum(h, np.linalg.norm(p[:, t[i]] - p[:, t[j]], axis=0))
-    return h
+from ..fem.meshes import cell_diameter, facet_containing
+from ..materials import lame_constants, linear_stress
 
 
 def _facet_length(mesh, facets) -> np.ndarray:
@@ -43,22 +43,14 @@ def _facet_length(mesh, facets) -> np.ndarray:
 def lame_stress(E: float, nu: float, plane: str = "strain"):
     """sigma(grad u) of linear elasticity (plane strain or plane stress) as a callable on
     gradient arrays G[i, j] = du_i/dx_j (shape (2, 2, ...))."""
-    if not (np.isfinite(E) and E > 0):
-        raise ValueError(f"E must be positive, got {E!r}")
-    if not (-1.0 < nu < 0.5):
-        raise ValueError(f"nu must lie in (-1, 0.5), got {nu!r}")
-    if plane not in ("strain", "stress"):
-        raise ValueError(f"plane must be 'strain' or 'stress', got {plane!r}")
-    lam = E * nu / ((1 + nu) * (1 - 2 * nu))
-    mu = E / (2 * (1 + nu))
-    if plane == "stress":
-        lam = 2 * lam * mu / (lam + 2 * mu)
+    return hooke_stress(*lame_constants(E, nu, plane))
 
+
+def hooke_stress(lam: float, mu: float):
+    """sigma(grad u) = 2 mu eps + lambda tr(eps) I, eps = sym grad u, as a callable on
+    gradient arrays G[i, j] = du_i/dx_j (shape (2, 2, ...))."""
     def sigma(G):
-        eps = 0.5 * (G + np.swapaxes(G, 0, 1))
-        tr = eps[0, 0] + eps[1, 1]
-        eye = np.eye(2).reshape((2, 2) + (1,) * (G.ndim - 2))
-        return lam * tr * eye + 2 * mu * eps
+        return linear_stress(0.5 * (G + np.swapaxes(G, 0, 1)), lam, mu)
 
     return sigma
 
@@ -88,7 +80,7 @@ def fe_indicators(basis: Basis, U, f=None, tractions: dict | None = None,
     mesh = basis.mesh
     elem = basis.elem
     nc = mesh.t.shape[1]
-    hK = _cell_diameter(mesh)
+    hK = cell_diameter(mesh)
     U = np.asarray(U, dtype=float)
     if U.shape != (basis.N,):
         raise ValueError(f"U must have {basis.N} entries (basis.N), got shape {U.shape}")
@@ -169,3 +161,79 @@ def energy_error_elasticity(basis: Basis, U, grad_u, stress) -> float:
         return np.einsum("ij...,ij...->...", stress(G), G)
 
     return float(np.sqrt(e2.assemble(basis, u=basis.interpolate(np.asarray(U, float)))))
+
+
+# --------------------------------------------------------------------------- two bodies
+def contact_traction_datum(mesh, label: str, points, tractions, axis: int = 0):
+    """The datum t(x, y, nx, ny) -> (2, ...) of (3.100) on the straight contact boundary
+    ``label`` of ``mesh`` (along the coordinate x_axis): the tractions (n, 2) at those of
+    the ``points`` (n, 2) lying on facets labelled ``label``, interpolated linearly in
+    x_axis (constant beyond the first and the last point) and zero outside the extent of
+    those facets."""
+    if axis not in (0, 1):
+        raise ValueError(f"axis must be 0 or 1, got {axis!r}")
+    facets = np.asarray((mesh.boundaries or {}).get(label, ()), dtype=np.int64)
+    if facets.size == 0:
+        raise ValueError(f"label {label!r} names no facets of mesh.boundaries "
+                         f"({sorted(mesh.boundaries or {})})")
+    pts = np.asarray(points, dtype=float)
+    tr = np.asarray(tractions, dtype=float)
+    if pts.ndim != 2 or pts.shape[1] != 2 or tr.shape != pts.shape:
+        raise ValueError(f"points and tractions must both have shape (n, 2), got "
+                         f"{pts.shape} and {tr.shape}")
+    on = facet_containing(mesh, facets, pts.T) >= 0
+    if not on.any():
+        raise ValueError(f"no point lies on the facets labelled {label!r}")
+    order = np.argsort(pts[on, axis])
+    xs, tr = pts[on, axis][order], tr[on][order]
+    ends = mesh.p[axis, mesh.facets[:, facets]]
+    lo, hi = float(ends.min()), float(ends.max())
+    tol = 1e-12 * max(1.0, hi - lo)
+
+    def datum(x, y, nx, ny):
+        s = x if axis == 0 else y
+        inside = (s >= lo - tol) & (s <= hi + tol)
+        return np.array([np.where(inside, np.interp(s, xs, tr[:, c]), 0.0) for c in (0, 1)])
+
+    return datum
+
+
+def _zero_traction(x, y, nx, ny):
+    return np.zeros((2,) + np.shape(x))
+
+
+def two_body_indicators(problem, result, contact=("C", "C"), free=((), ()), axis: int = 0,
+                        intorder: int | None = None):
+    """(eta_s, eta_m): indicator (3.100) per cell of the slave and of the master FE body
+    of a :class:`hpfebe.contact.two_body.TwoBodyContact` solution ``result``.
+
+    Datum on the slave facets labelled ``contact[0]``: the penalty traction
+    p_n n_m - t_t t_m at the slave contact points of positive weight, interpolated by
+    :func:`contact_traction_datum` (straight interface along x_axis); on the master facets
+    labelled ``contact[1]``: its negative at the same x_axis.  The facets labelled in
+    ``free[0]`` / ``free[1]`` are traction free; the others (Dirichlet) carry no term.
+    Stress: Hooke's law with each body's Lame constants."""
+    if len(contact) != 2 or len(free) != 2:
+        raise ValueError(f"contact and free must be (slave, master) pairs, got {contact!r}, "
+                         f"{free!r}")
+    S, M = problem.slave, problem.master
+    for name, body in (("slave", S), ("master", M)):
+        if not hasattr(body, "basis"):
+            raise ValueError(f"the {name} must be an FE body (ElasticBody), got "
+                             f"{type(body).__name__}")
+    w = np.asarray(result.weights)
+    traction = (result.p_n[:, None] * problem.normals - result.t_t[:, None] * problem.tangents)
+    sel = w > 0
+    f = contact_traction_datum(S.mesh, contact[0], result.points[sel], traction[sel], axis)
+
+    def on_master(x, y, nx, ny):
+        return -f(x, y, nx, ny)
+
+    out = []
+    for body, u, lab, g, fr in ((S, result.u_slave, contact[0], f, free[0]),
+                                (M, result.u_master, contact[1], on_master, free[1])):
+        fr = (fr,) if isinstance(fr, str) else tuple(fr)
+        tractions = {lab: g, **{name: _zero_traction for name in fr}}
+        out.append(fe_indicators(body.basis, u, stress=hooke_stress(body.lam, body.mu),
+                                 tractions=tractions, intorder=intorder))
+    return out[0], out[1]

@@ -23,6 +23,15 @@ from ..quadrature import gauss_legendre
 from ..spaces import ContinuousSpace, DiscontinuousSpace, legendre_values
 
 
+def energy_norm(S, U) -> float:
+    """sqrt(max(U . S U, 0)) for a symmetric positive semi-definite S (dense or sparse):
+    round-off can make U . S U slightly negative when U is nearly in the kernel."""
+    U = np.asarray(U, dtype=float)
+    if U.ndim != 1 or S.shape != (U.size, U.size):
+        raise ValueError(f"S must be square of the size of U; got S {S.shape}, U {U.shape}")
+    return float(np.sqrt(max(float(U @ S @ U), 0.0)))
+
+
 def _points(mesh, nq: int):
     """Gauss points of every element: elem (ne*nq,), t, x (.,2), n (.,2), weights ds."""
     t, w = gauss_legendre(nq)
@@ -90,7 +99,7 @@ def energy_error_neumann(op, psi_h, flux, extra: int = 4) -> float:
     lo_d, hi_d = op.W_space.elem_dofs, hi.W_space.elem_dofs
     mask = lo_d >= 0
     e[hi_d[:, :lo_d.shape[1]][mask]] -= np.asarray(psi_h)[lo_d[mask]]
-    return float(np.sqrt(max(e @ hi.V @ e, 0.0)))
+    return energy_norm(hi.V, e)
 
 
 def interpolation_difference(lo_space, hi_space, u_h, u) -> np.ndarray:
@@ -119,7 +128,7 @@ def energy_error_dirichlet(op, u_h, u, extra: int = 4) -> float:
     """|u - u_h|_W: u interpolated at degree p_I + extra, u_h embedded exactly."""
     hi = _richer(op, extra)
     e = interpolation_difference(op.V_space, hi.V_space, u_h, u)
-    return float(np.sqrt(max(e @ hi.W @ e, 0.0)))
+    return energy_norm(hi.W, e)
 
 
 def dual_energy_norm(op, residual) -> float:

@@ -24,13 +24,28 @@ INV_2PI = 1.0 / (2.0 * math.pi)
 
 LAPLACE_SL, LAPLACE_DL, LAME_SL, LAME_DL, LAME_HS = 0, 1, 2, 3, 4
 
+# Layout of the kernel parameter array kp (module-level integers: numba reads them as
+# compile-time constants).  Laplace (laplace.py): kp = [log(R) / (2 pi)].
+KP_LAPLACE_LOG_R = 0
+# Lame (lame.kernel_params), Et = E'/(4 pi), R the kernel length scale:
+#   [c1 log R, c1 c2, lambda, mu, c1, c2, Et log R, Et]
+KP_C1_LOG_R = 0     # c1 log R: regular part of the single layer G
+KP_C1_C2 = 1        # c1 c2: the r r^T / |r|^2 coefficient of G
+KP_LAMBDA = 2       # Lame constant lambda (lambda* in plane stress)
+KP_MU = 3           # Lame constant mu
+KP_C1 = 4           # c1 = (lambda + 3 mu) / (4 pi mu (lambda + 2 mu)): log coefficient of G
+KP_C2 = 5           # c2 = (lambda + mu) / (lambda + 3 mu)
+KP_ET_LOG_R = 6     # Et log R: regular part of the hypersingular kernel Vt
+KP_ET = 7           # Et = E' / (4 pi): factor (and log coefficient) of Vt
+KP_LAME_SIZE = 8
+
 
 @njit(cache=True)
 def laplace_single_layer(rx, ry, npts, nx, ny, kp, out):
-    """G(x,y) = -1/(2 pi) log(|r|/R): regular part log(R)/(2 pi) = kp[0]; the log part
-    -1/(2 pi) log|r| is ``logc``."""
+    """G(x,y) = -1/(2 pi) log(|r|/R): regular part log(R)/(2 pi) = kp[KP_LAPLACE_LOG_R];
+    the log part -1/(2 pi) log|r| is ``logc``."""
     for q in range(npts):
-        out[q, 0] = kp[0]
+        out[q, 0] = kp[KP_LAPLACE_LOG_R]
 
 
 @njit(cache=True)
@@ -41,7 +56,7 @@ def laplace_double_layer(rx, ry, npts, nx, ny, kp, out):
 
 
 # ------------------------------------------------------------------ 2D Lame (lame.py)
-# kp layout: [c1 log R, c1 c2, lambda, mu, c1, c2, Et log R, Et], Et = E'/(4 pi)
+# kp layout: the KP_* indices above
 @njit(cache=True, inline="always")
 def _log_rr(rx, ry, a0, a1, out):
     """a0 I + a1 r r^T / |r|^2 into out[0:4]."""
@@ -81,22 +96,22 @@ def lame_single_layer(rx, ry, npts, nx, ny, kp, out):
     """Regular part of G: c1 log R I + c1 c2 r r^T / |r|^2 (degree 0); the log part
     -c1 log|r| I is ``logc``."""
     for q in range(npts):
-        _log_rr(rx[q], ry[q], kp[0], kp[1], out[q])
+        _log_rr(rx[q], ry[q], kp[KP_C1_LOG_R], kp[KP_C1_C2], out[q])
 
 
 @njit(cache=True)
 def lame_double_layer(rx, ry, npts, nx, ny, kp, out):
     """Traction of G with respect to y, (1.4): K_ik = [sigma_y(G e_i) n_y]_k."""
     for q in range(npts):
-        _traction_of_G(rx[q], ry[q], ny[0], ny[1], kp[2], kp[3], kp[4], kp[5], out[q])
+        _traction_of_G(rx[q], ry[q], ny[0], ny[1], kp[KP_LAMBDA], kp[KP_MU], kp[KP_C1],
+                       kp[KP_C2], out[q])
 
 
 @njit(cache=True)
 def lame_hypersingular(rx, ry, npts, nx, ny, kp, out):
     """Regular part of Vt: E'/(4 pi) (log R I + r r^T/|r|^2); log part -E'/(4 pi) log|r| I."""
     for q in range(npts):
-        _log_rr(rx[q], ry[q], kp[6], kp[7], out[q])
-
+        _log_rr(rx[q], ry[q], kp[KP_ET_LOG_R], kp[KP_ET], out[q])
 
 
 @njit(cache=True)

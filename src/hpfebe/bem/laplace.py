@@ -46,18 +46,19 @@ import numpy as np
 from ..geometry import BoundaryMesh
 from ..spaces import ContinuousSpace, DiscontinuousSpace
 from .assembly import assemble, sandwich
-from .kernels import INV_2PI, LAPLACE_DL, LAPLACE_SL
+from .kernels import INV_2PI, KP_LAPLACE_LOG_R, LAPLACE_DL, LAPLACE_SL
 from .operators import BoundaryOperators
 from .potentials import POT_LAPLACE_DL, POT_LAPLACE_SL, evaluate_potential
-
-
 
 SINGLE_LAYER_LOGC = np.array([-INV_2PI])
 NO_LOG = np.array([0.0])
 
 
 def _scale_param(R: float) -> np.ndarray:
-    return np.array([math.log(R) * INV_2PI])
+    """Kernel parameter array kp of the Laplace kernels (index KP_LAPLACE_LOG_R)."""
+    kp = np.empty(KP_LAPLACE_LOG_R + 1)
+    kp[KP_LAPLACE_LOG_R] = math.log(R) * INV_2PI
+    return kp
 
 
 class LaplaceBEM(BoundaryOperators):

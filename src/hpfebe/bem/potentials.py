@@ -6,8 +6,8 @@ for a potential kernel given by an integer id (``POT_*`` below, dispatched by
 :func:`pot_kernel`, like the kernel ids of :mod:`hpfebe.bem.kernels`: numba's disk cache
 cannot hold functions specialised on function-typed arguments) that writes the full
 (nout x d) kernel matrix row-major (out[a * d + c]), r = x - y, log part included.
-Each element is bisected until the point is at least one sub-element length away, then Gauss with an order that grows with
-log(size / distance) (the rule of :func:`hpfebe.bem.integration._order`), so the
+Each element is bisected until the point is at least one sub-element length away, then
+Gauss with an order that grows with log(size / distance) (the rule of :func:`hpfebe.bem.integration._order`), so the
 accuracy holds uniformly up to (not on) the boundary.
 """
 
@@ -21,7 +21,8 @@ from numba import njit, prange
 from ..quadrature import rule_tables
 from ..spaces import P_MAX, eval_basis, gll_tables, n_local
 from .integration import NMAX, _order, point_panels
-from .kernels import INV_2PI, _log_rr, _traction_of_G
+from .kernels import (INV_2PI, KP_C1, KP_C1_C2, KP_C1_LOG_R, KP_C2, KP_LAMBDA,
+                      KP_LAPLACE_LOG_R, KP_MU, _log_rr, _traction_of_G)
 
 # potential kernel ids; kp is the parameter array of the owning operator class
 POT_LAME_SL, POT_LAME_DL, POT_LAME_SL_GRAD, POT_LAME_DL_GRAD = 0, 1, 2, 3
@@ -87,21 +88,24 @@ def _lame_grad_kernels(rx, ry, ny0, ny1, lam, mu, c1, c2, double, out):
 @njit(cache=True)
 def pot_kernel(kid, rx, ry, ny0, ny1, kp, out):
     """Full kernel at r = x - y (x off Gamma): Laplace G and d_{n_y} G (kp = [log(R)/(2 pi)]),
-    Lame G (single layer, kp of :func:`hpfebe.bem.lame.kernel_params`), its y-traction
-    (double layer), or the
-    x-gradients of both (nout = 4: rows (i, m) = d/dx_m of component i)."""
+    Lame G (single layer, kp of :func:`hpfebe.bem.lame.kernel_params`, indices KP_* of
+    :mod:`.kernels`), its y-traction (double layer), or the x-gradients of both (nout = 4:
+    rows (i, m) = d/dx_m of component i)."""
     if kid == POT_LAPLACE_SL:
-        out[0] = kp[0] - INV_2PI * 0.5 * math.log(rx * rx + ry * ry)
+        out[0] = kp[KP_LAPLACE_LOG_R] - INV_2PI * 0.5 * math.log(rx * rx + ry * ry)
     elif kid == POT_LAPLACE_DL:
         out[0] = INV_2PI * (rx * ny0 + ry * ny1) / (rx * rx + ry * ry)
     elif kid == POT_LAME_SL:
-        _log_rr(rx, ry, kp[0] - 0.5 * kp[4] * math.log(rx * rx + ry * ry), kp[1], out)
+        _log_rr(rx, ry, kp[KP_C1_LOG_R] - 0.5 * kp[KP_C1] * math.log(rx * rx + ry * ry),
+                kp[KP_C1_C2], out)
     elif kid == POT_LAME_DL:
-        _traction_of_G(rx, ry, ny0, ny1, kp[2], kp[3], kp[4], kp[5], out)
+        _traction_of_G(rx, ry, ny0, ny1, kp[KP_LAMBDA], kp[KP_MU], kp[KP_C1], kp[KP_C2], out)
     elif kid == POT_LAME_SL_GRAD:
-        _lame_grad_kernels(rx, ry, ny0, ny1, kp[2], kp[3], kp[4], kp[5], False, out)
+        _lame_grad_kernels(rx, ry, ny0, ny1, kp[KP_LAMBDA], kp[KP_MU], kp[KP_C1], kp[KP_C2],
+                           False, out)
     elif kid == POT_LAME_DL_GRAD:
-        _lame_grad_kernels(rx, ry, ny0, ny1, kp[2], kp[3], kp[4], kp[5], True, out)
+        _lame_grad_kernels(rx, ry, ny0, ny1, kp[KP_LAMBDA], kp[KP_MU], kp[KP_C1], kp[KP_C2],
+                           True, out)
     else:
         raise ValueError("unknown potential kernel id")
 

@@ -1,22 +1,24 @@
 """Coercivity threshold of the Nitsche form a_h (Lemma 2.2.3) computed, not bounded.
 
-Write the matrix of a_h as A(lam) = A0 + lam P (``NitscheFEBE.blocks``): A0 holds the FE
-stiffness, S_hat and the two flux terms, P the penalty term <h1^-1 p1^alpha [U], [Phi]>.
-P is positive semidefinite and acts only on the dofs whose traces live on Gamma_I ("I");
-on every function with [Phi] = 0 the form is (grad Phi1, grad Phi1) + <S_hat Phi2, Phi2> > 0.
-Hence, with R the remaining dofs (A0_RR is positive definite: their functions have no jump),
+Write the matrix of a_h as A(l) = A0 + l P, l = lambda_Nit (``NitscheFEBE.blocks``): A0
+holds the FE stiffness, S_hat and the two flux terms, P the penalty term
+<h1^-1 p1^alpha [U], [Phi]>.  P is positive semidefinite and acts only on the dofs whose
+traces live on Gamma_I ("I"); on every function with [Phi] = 0 the form is
+(grad Phi1, grad Phi1) + <S_hat Phi2, Phi2> > 0.  Hence, with R the remaining dofs (A0_RR
+is positive definite: their functions have no jump),
 
-    A(lam) > 0   <=>   S0 + lam P_II > 0,   S0 = A0_II - A0_IR A0_RR^-1 A0_RI,
+    A(l) > 0   <=>   S0 + l P_II > 0,   S0 = A0_II - A0_IR A0_RR^-1 A0_RI,
 
-and the threshold lam* = inf{lam : A(lam) > 0} is the largest generalised eigenvalue mu of
+and the threshold lambda* = inf{l : A(l) > 0} is the largest generalised eigenvalue mu of
 S0 x = -mu P_II x.  We compute it stably from the definite pencil (P_II, B),
-B = S0 + L P_II > 0 for some L (found by doubling): P_II x = nu B x, lam* = L - 1/nu_max.
-lam* <= 0 means a_h is positive definite for every lambda_Nit >= 0.
+B = S0 + L P_II > 0 for some L (found by doubling): P_II x = nu B x, lambda* = L - 1/nu_max.
+lambda* <= 0 means a_h is positive definite for every lambda_Nit >= 0.
 
-Because P scales like p1^alpha for a uniform degree, lam*(alpha) = lam*(0) p^-alpha exactly.
+Because P scales like p1^alpha for a uniform degree, lambda*(alpha) = lambda*(0) p^-alpha
+exactly.
 
-The bound of Lemma 2.2.3 (as printed, gamma = 2): lam >= 1/2 p^(gamma - alpha) + C_inv
-p^(2 - alpha), with C_inv the constant of the squared inverse inequality (2.7),
+The bound of Lemma 2.2.3 (as printed, gamma = 2): lambda_Nit >= 1/2 p^(gamma - alpha) +
+C_inv p^(2 - alpha), with C_inv the constant of the squared inverse inequality (2.7),
 sum_J h_K p^-gamma ||dn Phi||^2_J <= C_inv p^(2 - gamma) ||grad Phi||^2_Omega1, computed
 here as the largest eigenvalue of that pencil on V1_hp (``inverse_constant``).
 """
@@ -46,7 +48,7 @@ def _schur(A: sp.spmatrix, I: np.ndarray, R: np.ndarray, chunk: int = 256) -> np
 
 
 def _largest_pencil_threshold(S0: np.ndarray, P: np.ndarray) -> float:
-    """Largest mu with S0 + mu P singular, S0 + lam P > 0 for lam > mu (P >= 0)."""
+    """Largest mu with S0 + mu P singular, S0 + l P > 0 for l > mu (P >= 0)."""
     L = 1.0
     for _ in range(60):
         try:
@@ -65,7 +67,7 @@ def _largest_pencil_threshold(S0: np.ndarray, P: np.ndarray) -> float:
 
 
 def coercivity_threshold(model: NitscheFEBE) -> float:
-    """lam* = inf{lambda_Nit : a_h positive definite on V_hp} for ``model``'s alpha."""
+    """lambda* = inf{lambda_Nit : a_h positive definite on V_hp} for ``model``'s alpha."""
     K11a, K12a, K22a = model.blocks(0.0)
     K11b, K12b, K22b = model.blocks(1.0)
     A0 = sp.bmat([[K11a, K12a], [K12a.T, sp.csr_matrix(K22a)]]).tocsr()

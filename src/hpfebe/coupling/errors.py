@@ -37,23 +37,26 @@ def fe_errors(model: NitscheFEBE, sol: NitscheSolution) -> dict:
     return model.fe.errors(sol.U1, model.problem.u, model.problem.grad_u)
 
 
-def _boundary_values(model: NitscheFEBE, U2, pts, tol=1e-11):
-    """U2 at points on dOmega2 (NaN where a point is not on the boundary)."""
-    m = model.be_mesh
-    a, b = m.a, m.b
-    ab = b - a
-    L2 = (ab ** 2).sum(1)
-    out = np.full(len(pts), np.nan)
-    for s in range(0, len(pts), 4096):
-        x = pts[s:s + 4096, None, :]
-        t = np.clip(((x - a[None]) * ab[None]).sum(-1) / L2[None], 0.0, 1.0)
-        d = np.linalg.norm(x - (a[None] + t[..., None] * ab[None]), axis=-1)
-        e = d.argmin(axis=1)
-        hit = d[np.arange(len(e)), e] < tol
-        if hit.any():
-            tt = 2.0 * t[np.arange(len(e)), e][hit] - 1.0
-            out[s:s + 4096][hit] = model.bem.V_space.evaluate(U2, e[hit], tt)
+def boundary_values(model: NitscheFEBE, U2, pts) -> np.ndarray:
+    """U2 at the points ``pts`` (n, 2) that lie on dOmega2 (the BE mesh), NaN at the
+    others (:meth:`hpfebe.geometry.BoundaryMesh.locate`)."""
+    elem, t = model.be_mesh.locate(pts)
+    out = np.full(len(elem), np.nan)
+    on = elem >= 0
+    if on.any():
+        out[on] = model.bem.V_space.evaluate(U2, elem[on], t[on])
     return out
+
+
+def be_solution_at(model: NitscheFEBE, U2, pts) -> np.ndarray:
+    """The BE solution at points of the closure of Omega2: U2 on dOmega2, the
+    representation formula u~ = V Psi - K U2 (Psi = Psi(U2)) inside."""
+    pts = np.asarray(pts, dtype=float)
+    vals = boundary_values(model, U2, pts)
+    inner = np.isnan(vals)
+    if inner.any():
+        vals[inner] = model.bem.representation(pts[inner], U2, model.bem.Psi(U2))
+    return vals
 
 
 def _lagrange(nodes: np.ndarray, t: np.ndarray, derivative: bool = False) -> np.ndarray:
@@ -116,9 +119,7 @@ def be_domain_errors(model: NitscheFEBE, sol: NitscheSolution, n_gauss: int | No
     if interpolate_exact:
         vals = pb.u(pts[:, 0], pts[:, 1])
     else:
-        vals = _boundary_values(model, sol.U2, pts)
-        inner = np.isnan(vals)
-        vals[inner] = model.bem.representation(pts[inner], sol.U2, model.bem.Psi(sol.U2))
+        vals = be_solution_at(model, sol.U2, pts)
     V = vals[inv.ravel()].reshape(X.shape)                          # (nc, p+1, p+1)
 
     nq = n_gauss or p + 6

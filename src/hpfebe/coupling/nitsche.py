@@ -12,15 +12,16 @@ flux {dn Phi} := dn Phi1 of [31]); h1, p1: size and degree of the FE element K a
 
 Algebraic form (Section 2.2.4), dofs not on Gamma_D only:
 
-    [ A1 - F11 - F11^T + lam P11     F21^T - lam P12 ] [U1]   [f1]
-    [ F21 - lam P12^T                S_hat + lam P22 ] [U2] = [f2]
+    [ A1 - F11 - F11^T + lambda_nit P11     F21^T - lambda_nit P12 ] [U1]   [f1]
+    [ F21 - lambda_nit P12^T                S_hat + lambda_nit P22 ] [U2] = [f2]
 
     F11 = N^T W Dn,  F21 = B^T W Dn,  P11 = N^T W_s N,  P12 = N^T W_s B,  P22 = B^T W_s B,
 
-with N, Dn, B the FE values, FE normal derivatives and BE values at the Gauss points of the
-common refinement (:mod:`.interface`), W the weights and W_s = W h1^-1 p1^alpha.  Everything
-except the factor lam = lambda_Nit is assembled once (``NitscheFEBE.__init__``), so a
-lambda_Nit sweep only rescales the penalty blocks (``blocks(lam)``).
+with N, Dn, B the FE values, FE normal derivatives and BE values (V_hp trace matrix) at the
+Gauss points of the common refinement (:mod:`.interface`), W the weights and
+W_s = W h1^-1 p1^alpha.  Everything except the factor lambda_nit = lambda_Nit is assembled
+once (``NitscheFEBE.__init__``), so a lambda_Nit sweep only rescales the penalty blocks
+(``blocks(lambda_nit)``).
 
 alpha and h1: the thesis does not state the alpha of its experiments, and defines h_K as
 the diameter of K.  The defaults DEFAULT_ALPHA = 0 and h1 = the length of K's edge on
@@ -53,7 +54,6 @@ import scipy.sparse.linalg as spla
 from ..bem import LaplaceBEM
 from ..fem.poisson import PoissonFE
 from ..quadrature import gauss_legendre
-from ..spaces import lagrange_values
 from .examples import InterfaceProblem
 from .interface import interface_rule
 
@@ -69,27 +69,10 @@ class NitscheSolution:
     """Solution of (2.3): U1 (FE, all dofs of ``fe``), U2 (BE, all dofs of ``V_space``),
     and solver diagnostics (``info``: residual, timings, sizes)."""
 
-    lam: float
+    lambda_nit: float
     U1: np.ndarray
     U2: np.ndarray
     info: dict = field(default_factory=dict)
-
-
-def be_values(be_mesh, V_space, elem, t) -> sp.csr_matrix:
-    """Sparse (npts x ndof) values of the V_hp basis at reference points ``t`` of the
-    boundary elements ``elem`` (grouped by degree, vectorised)."""
-    n = len(elem)
-    rows, cols, vals = [], [], []
-    for p in np.unique(be_mesh.degrees[elem]):
-        sel = np.flatnonzero(be_mesh.degrees[elem] == p)
-        phi = lagrange_values(int(p), t[sel])                      # (k, p+1)
-        dofs = V_space.elem_dofs[elem[sel], :int(p) + 1]
-        keep = dofs >= 0
-        rows.append(np.broadcast_to(sel[:, None], dofs.shape)[keep])
-        cols.append(dofs[keep])
-        vals.append(phi[keep])
-    return sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
-                         shape=(n, V_space.ndof))
 
 
 class NitscheFEBE:
@@ -142,7 +125,7 @@ class NitscheFEBE:
         self.rule = rule = interface_rule(self.domain, self.be_mesh, order, h_def)
         N, Gx, Gy = self.fe.eval_matrices(rule.x, rule.fe_cell)
         Dn = sp.diags(rule.n1[:, 0]) @ Gx + sp.diags(rule.n1[:, 1]) @ Gy
-        Bv = be_values(self.be_mesh, V, rule.be_elem, rule.t_be)
+        Bv = V.trace_matrix(rule.be_elem, rule.t_be)
         sigma = self.fe.p ** self.alpha / rule.h1           # h1^-1 p1^alpha
         W, Ws = sp.diags(rule.w), sp.diags(rule.w * sigma)
         f1, f2 = self.free1, self.free2
@@ -187,39 +170,41 @@ class NitscheFEBE:
         gx, gy = self.problem.grad_u(x[:, 0], x[:, 1])
         n = mesh.normals[e]
         g = (gx * n[:, 0] + gy * n[:, 1]) * np.tile(wq, len(els)) * mesh.lengths[e] / 2
-        return be_values(mesh, V, e, t).T @ g
+        return V.trace_matrix(e, t).T @ g
 
     # ----------------------------------------------------------------- the system
-    def blocks(self, lam: float):
-        """K11 (sparse), K12 (sparse), K22 (dense) of the system for lambda_Nit = lam."""
-        lam = self._check_lambda(lam)
-        K11 = (self.A1 - self.F11 - self.F11.T + lam * self.P11).tocsc()
-        K12 = (self.F21.T - lam * self.P12).tocsc()
-        K22 = self.S + lam * self.P22
+    def blocks(self, lambda_nit: float):
+        """K11 (sparse), K12 (sparse), K22 (dense) of the system for lambda_Nit."""
+        lambda_nit = self._check_lambda(lambda_nit)
+        K11 = (self.A1 - self.F11 - self.F11.T + lambda_nit * self.P11).tocsc()
+        K12 = (self.F21.T - lambda_nit * self.P12).tocsc()
+        K22 = self.S + lambda_nit * self.P22
         return K11, K12, K22
 
-    def matrix(self, lam: float) -> sp.csr_matrix:
+    def matrix(self, lambda_nit: float) -> sp.csr_matrix:
         """The whole system matrix (sparse, BE block stored densely) - for checks."""
-        K11, K12, K22 = self.blocks(lam)
+        K11, K12, K22 = self.blocks(lambda_nit)
         return sp.bmat([[K11, K12], [K12.T, sp.csr_matrix(K22)]]).tocsr()
 
     @staticmethod
-    def _check_lambda(lam) -> float:
-        lam = float(lam)
-        if not (np.isfinite(lam) and lam >= 0):
-            raise ValueError(f"lambda_Nit must be a finite number >= 0, got {lam!r}")
-        return lam
+    def _check_lambda(lambda_nit) -> float:
+        value = float(lambda_nit)
+        if not (np.isfinite(value) and value >= 0):
+            raise ValueError(f"lambda_nit (lambda_Nit) must be a finite number >= 0, "
+                             f"got {lambda_nit!r}")
+        return value
 
-    def solve(self, lam: float = DEFAULT_LAMBDA) -> NitscheSolution:
+    def solve(self, lambda_nit: float = DEFAULT_LAMBDA) -> NitscheSolution:
         """Solve (2.3) by one sparse LU of the coupled system (module doc)."""
         t0 = time.perf_counter()
-        K11, K12, K22 = self.blocks(lam)
+        lambda_nit = self._check_lambda(lambda_nit)
+        K11, K12, K22 = self.blocks(lambda_nit)
         K21 = K12.T.tocsr()
         try:
-            lu = spla.splu(self.matrix(lam).tocsc())
+            lu = spla.splu(self.matrix(lambda_nit).tocsc())
         except RuntimeError as exc:
-            raise np.linalg.LinAlgError(f"coupled system singular for lambda_Nit={lam}: "
-                                        f"{exc}") from exc
+            raise np.linalg.LinAlgError(f"coupled system singular for lambda_Nit="
+                                        f"{lambda_nit}: {exc}") from exc
         x = lu.solve(np.concatenate([self.b1, self.b2]))
         U1, U2 = x[:self.n1], x[self.n1:]
         r1 = K11 @ U1 + K12 @ U2 - self.b1
@@ -227,14 +212,14 @@ class NitscheFEBE:
         bnorm = np.sqrt(self.b1 @ self.b1 + self.b2 @ self.b2)
         res = float(np.sqrt(r1 @ r1 + r2 @ r2) / max(bnorm, np.finfo(float).tiny))
         if not (np.all(np.isfinite(U1)) and np.all(np.isfinite(U2))):
-            raise FloatingPointError(f"solution not finite for lambda_Nit={lam}")
+            raise FloatingPointError(f"solution not finite for lambda_Nit={lambda_nit}")
         if res > 1e-6:
-            raise np.linalg.LinAlgError(f"coupled solve inaccurate for lambda_Nit={lam}: "
-                                        f"relative residual {res:.2e}")
+            raise np.linalg.LinAlgError(f"coupled solve inaccurate for lambda_Nit="
+                                        f"{lambda_nit}: relative residual {res:.2e}")
         full1 = np.zeros(self.fe.ndof)
         full1[self.free1] = U1
         full2 = np.zeros(self.bem.V_space.ndof)
         full2[self.free2] = U2
         info = {"residual": res, "solve_s": time.perf_counter() - t0, "n_fe": self.n1,
                 "n_be": self.n2, **self.timings}
-        return NitscheSolution(float(lam), full1, full2, info)
+        return NitscheSolution(float(lambda_nit), full1, full2, info)

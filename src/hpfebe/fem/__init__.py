@@ -1,6 +1,11 @@
-"""Finite element parts (scikit-fem based): meshes of the FE subdomain and Poisson Q_p."""
+"""Finite element parts (scikit-fem based): labelled meshes, Poisson Q_p, linear elasticity."""
 
-from .meshes import FEDomain, block_grid, tensor_block_mesh
+from .meshes import (Concentration, FEDomain, block_grid, cell_diameter, distance_to_set,
+                     facet_containing, is_conforming, local_mesh_size, new_vertices,
+                     refine_labelled, refinement_concentration, tensor_block_mesh)
 from .poisson import PoissonFE, quad_element
 
-__all__ = ["FEDomain", "block_grid", "tensor_block_mesh", "PoissonFE", "quad_element"]
+__all__ = ["Concentration", "FEDomain", "block_grid", "cell_diameter", "distance_to_set",
+           "facet_containing", "is_conforming", "local_mesh_size", "new_vertices",
+           "refine_labelled", "refinement_concentration", "tensor_block_mesh", "PoissonFE",
+           "quad_element"]

@@ -21,10 +21,26 @@ ceil(h_inv/2) rows: for h_inv = 5 this is the thesis's "75 finite elements" (Sec
 2.2.5), and it reproduces the FE errors of Table 2.2 for p = 1, 2 to within 3 %
 (``rounding="ceil"``, 3 rows in both blocks, 85 elements, gives errors 15-40 % smaller).
 Every interface edge has size exactly 1/h_inv.
+
+Labelled meshes (any scikit-fem mesh with named boundary facets ``mesh.boundaries``):
+
+* :func:`cell_diameter` - h_K = diam K, the largest distance between two vertices of K
+  (the longest edge of a triangle, the longer diagonal of a rectangle): the one cell size
+  of the package (FE indicators, Nitsche weights, mesh statistics);
+* :func:`refine_labelled` - conforming refinement (scikit-fem's ``refined``: red
+  refinement of all cells, or red-green-blue refinement of the marked triangles with
+  closure) whose boundary facets inherit the labels of the facets they lie on (scikit-fem
+  drops the labels in its adaptive refinement);
+* :func:`is_conforming` - no hanging nodes: every facet with one neighbour lies on the
+  boundary of a reference mesh (the initial, conforming one), every vertex is used;
+* :func:`new_vertices`, :func:`local_mesh_size`, :func:`distance_to_set`,
+  :func:`refinement_concentration` - where a refinement put its new vertices.
 """
 
 from __future__ import annotations
 
+import logging
+import math
 from dataclasses import dataclass
 from typing import Callable, Sequence
 
@@ -80,11 +96,9 @@ class FEDomain:
         return np.linalg.norm(p[:, 1] - p[:, 0], axis=0)
 
     def cell_diameter(self, cells) -> np.ndarray:
-        """Diameter of the (convex) quadrilaterals: the longer diagonal."""
-        x = self.mesh.p[:, self.mesh.t[:, cells]]
-        d1 = np.linalg.norm(x[:, 2] - x[:, 0], axis=0)
-        d2 = np.linalg.norm(x[:, 3] - x[:, 1], axis=0)
-        return np.maximum(d1, d2)
+        """Diameter of the cells ``cells`` (:func:`cell_diameter`; the longer diagonal of
+        a rectangle)."""
+        return cell_diameter(self.mesh, cells)
 
 
 def tensor_block_mesh(xbreaks, ybreaks, h_inv: float,
@@ -115,3 +129,179 @@ def tensor_block_mesh(xbreaks, ybreaks, h_inv: float,
     labs = np.asarray(label(mid[0], mid[1]))
     facets = {str(lab): bf[labs == lab] for lab in np.unique(labs)}
     return FEDomain(mesh, facets, float(h_inv))
+
+
+# --------------------------------------------------------------------------- labelled meshes
+def cell_diameter(mesh, cells=None) -> np.ndarray:
+    """h_K = diam K of the cells ``cells`` (all if None): the largest distance between two
+    vertices of K (cells are convex polygons with straight sides)."""
+    t = mesh.t if cells is None else mesh.t[:, np.asarray(cells, dtype=np.int64)]
+    x = mesh.p[:, t]                                   # (2, n_vertices_per_cell, n)
+    h = np.zeros(t.shape[1])
+    for i in range(t.shape[0]):
+        for j in range(i + 1, t.shape[0]):
+            h = np.maximum(h, np.linalg.norm(x[:, i] - x[:, j], axis=0))
+    return h
+
+
+def _scale(mesh) -> float:
+    return float(max(np.ptp(mesh.p, axis=1).max(), np.finfo(float).tiny))
+
+
+def facet_containing(mesh, facets, points, tol: float = 1e-10,
+                     chunk: int = 4_000_000) -> np.ndarray:
+    """For each of the points (2, n): the index into ``facets`` of a facet of ``mesh``
+    containing it (distance <= tol times the mesh's extent), -1 if there is none."""
+    facets = np.asarray(facets, dtype=np.int64)
+    pts = np.asarray(points, dtype=float)
+    if pts.ndim != 2 or pts.shape[0] != 2:
+        raise ValueError(f"points must have shape (2, n), got {pts.shape}")
+    out = np.full(pts.shape[1], -1, dtype=np.int64)
+    if facets.size == 0 or pts.shape[1] == 0:
+        return out
+    a = mesh.p[:, mesh.facets[0, facets]].T            # (m, 2)
+    ab = mesh.p[:, mesh.facets[1, facets]].T - a
+    L2 = np.sum(ab ** 2, axis=1)
+    eps = tol * _scale(mesh)
+    step = max(1, chunk // facets.size)
+    for s in range(0, pts.shape[1], step):
+        q = pts[:, s:s + step].T[:, None, :]           # (k, 1, 2)
+        lam = np.clip(np.sum((q - a) * ab, axis=-1) / L2, 0.0, 1.0)
+        d = np.linalg.norm(q - (a + lam[..., None] * ab), axis=-1)
+        j = np.argmin(d, axis=1)
+        hit = d[np.arange(j.size), j] <= eps
+        out[s:s + step] = np.where(hit, j, -1)
+    return out
+
+
+def _facet_midpoints(mesh, facets) -> np.ndarray:
+    return mesh.p[:, mesh.facets[:, facets]].mean(axis=1)
+
+
+def refine_labelled(mesh, marked=None):
+    """Conforming refinement of a labelled scikit-fem mesh: all cells if ``marked`` is
+    None or marks every cell (scikit-fem's uniform red refinement), else the cells of the
+    boolean mask ``marked`` (red-green-blue refinement with closure, ``MeshTri`` only).
+    Every boundary facet of the new mesh carries the labels of the facet of ``mesh`` it
+    lies on (labels survive any number of refinements; the labelled facet sets are
+    sorted)."""
+    if marked is not None:
+        marked = np.asarray(marked)
+        if marked.dtype != bool or marked.shape != (mesh.t.shape[1],):
+            raise ValueError(f"marked must be a boolean mask of the {mesh.t.shape[1]} cells, "
+                             f"got dtype {marked.dtype}, shape {marked.shape}")
+    skfem_log = logging.getLogger("skfem.mesh.mesh")
+    level = skfem_log.level
+    skfem_log.setLevel(logging.ERROR)   # "Named boundaries invalidated": relabelled below
+    try:
+        new = mesh.refined() if marked is None or marked.all() else \
+            mesh.refined(np.flatnonzero(marked))
+    finally:
+        skfem_log.setLevel(level)
+    labels = mesh.boundaries or {}
+    if not labels:
+        return new
+    old_bf = mesh.boundary_facets()
+    bf = new.boundary_facets()
+    parent = facet_containing(mesh, old_bf, _facet_midpoints(new, bf))
+    has = np.zeros(mesh.facets.shape[1], dtype=bool)
+    out = {}
+    for name, facets in labels.items():
+        has[:] = False
+        has[np.asarray(facets, dtype=np.int64)] = True
+        sel = (parent >= 0) & has[old_bf[np.maximum(parent, 0)]]
+        out[name] = np.sort(bf[sel]).astype(np.int32)
+    return new.with_boundaries(out)
+
+
+def is_conforming(mesh, reference) -> bool:
+    """No hanging nodes: every facet of ``mesh`` with one neighbour lies on a boundary
+    facet of ``reference`` (a conforming mesh of the same domain, e.g. the initial one),
+    and every vertex belongs to some cell."""
+    bf = mesh.boundary_facets()
+    on = facet_containing(reference, reference.boundary_facets(), _facet_midpoints(mesh, bf))
+    used = np.zeros(mesh.p.shape[1], dtype=bool)
+    used[mesh.t.ravel()] = True
+    return bool(np.all(on >= 0) and np.all(used))
+
+
+def new_vertices(mesh0, mesh) -> np.ndarray:
+    """Boolean mask of the vertices of ``mesh`` that are not vertices of ``mesh0``
+    (coordinates compared after rounding to 12 decimals)."""
+    key = np.round(np.hstack([mesh0.p, mesh.p]).T, 12) + 0.0     # + 0.0: -0.0 -> 0.0
+    _, inv = np.unique(key, axis=0, return_inverse=True)
+    inv = inv.ravel()
+    n0 = mesh0.p.shape[1]
+    return ~np.isin(inv[n0:], inv[:n0])
+
+
+def distance_to_set(points, segments=(), vertices=()) -> np.ndarray:
+    """Distance of the points (2, n) to the union of the ``segments`` ((a, b) pairs of
+    points) and the single points ``vertices``."""
+    p = np.asarray(points, dtype=float)
+    if p.ndim != 2 or p.shape[0] != 2:
+        raise ValueError(f"points must have shape (2, n), got {p.shape}")
+    d = np.full(p.shape[1], np.inf)
+    for a, b in segments:
+        a, b = np.asarray(a, dtype=float), np.asarray(b, dtype=float)
+        ab = b - a
+        lam = ((p[0] - a[0]) * ab[0] + (p[1] - a[1]) * ab[1]) / (ab @ ab)
+        # beyond an end: the distance to that end point, computed from it
+        dx = np.where(lam <= 0, p[0] - a[0], np.where(lam >= 1, p[0] - b[0],
+                                                      p[0] - a[0] - lam * ab[0]))
+        dy = np.where(lam <= 0, p[1] - a[1], np.where(lam >= 1, p[1] - b[1],
+                                                      p[1] - a[1] - lam * ab[1]))
+        d = np.minimum(d, np.hypot(dx, dy))
+    if len(vertices):
+        v = np.asarray(vertices, dtype=float).reshape(-1, 2)
+        d = np.minimum(d, np.min(np.hypot(p[0][None] - v[:, :1], p[1][None] - v[:, 1:]),
+                                 axis=0))
+    return d
+
+
+def local_mesh_size(mesh, points) -> np.ndarray:
+    """Mesh size at each of the points (n, 2): the largest diameter h_K of the cells whose
+    centroid lies within h_K of the point (NaN if there is none)."""
+    pts = np.asarray(points, dtype=float).reshape(-1, 2)
+    h = cell_diameter(mesh)
+    cent = mesh.p[:, mesh.t].mean(axis=1)
+    dc = np.hypot(cent[0][None] - pts[:, :1], cent[1][None] - pts[:, 1:])   # (n, cells)
+    near = dc <= np.maximum(h, 1e-14)[None]
+    hn = np.where(near, h[None], -np.inf).max(axis=1)
+    return np.where(near.any(axis=1), hn, math.nan)
+
+
+@dataclass(frozen=True)
+class Concentration:
+    """Where a refinement put its vertices: ``n_new`` vertices added, ``share`` of them
+    within the radius of a set, ``area_share`` of the domain within that radius."""
+
+    n_new: int
+    share: float
+    area_share: float
+
+    @property
+    def enrichment(self) -> float:
+        """Density of the new vertices near the set relative to their mean density."""
+        if self.area_share > 0 and not math.isnan(self.share):
+            return self.share / self.area_share
+        return math.nan
+
+
+def refinement_concentration(mesh0, mesh, distance, radius: float,
+                             n_sample: int = 400) -> Concentration:
+    """Share of the vertices of ``mesh`` added since ``mesh0`` with ``distance(p) <=
+    radius`` (``distance`` maps points (2, n) to distances, e.g. :func:`distance_to_set`),
+    and the share of the area within the radius, sampled on an n_sample x n_sample grid
+    of the bounding box of ``mesh0`` (its area for a rectangle)."""
+    if not (np.isfinite(radius) and radius > 0):
+        raise ValueError(f"radius must be positive, got {radius!r}")
+    if int(n_sample) != n_sample or n_sample < 2:
+        raise ValueError(f"n_sample must be an integer >= 2, got {n_sample!r}")
+    new = new_vertices(mesh0, mesh)
+    d = np.asarray(distance(mesh.p[:, new]))
+    share = float(np.mean(d <= radius)) if new.any() else math.nan
+    (x0, y0), (x1, y1) = mesh0.p.min(axis=1), mesh0.p.max(axis=1)
+    X, Y = np.meshgrid(np.linspace(x0, x1, int(n_sample)), np.linspace(y0, y1, int(n_sample)))
+    area = float(np.mean(np.asarray(distance(np.vstack([X.ravel(), Y.ravel()]))) <= radius))
+    return Concentration(int(new.sum()), share, area)
