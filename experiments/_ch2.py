@@ -1,68 +1,41 @@
-"""Shared sweeps of the Chapter 2 experiments (private helper, not an experiment module).
-
-``sweep`` builds the coupled system of each mesh pair once and solves it for every
-lambda_Nit requested (only the penalty blocks are rescaled), then measures the FE- and
-BE-part errors with :mod:`hpfebe.coupling.errors`.
+"""Shared helpers of the Chapter 2 experiments (private, not an experiment module):
+sweep tables, published-format tables, joins with the published tables, reference
+slopes.  The numerics are :func:`hpfebe.coupling.errors.lambda_sweep` and
+:func:`hpfebe.analysis.rates.observed_rates`.
 """
 
 from __future__ import annotations
 
 import logging
-import time
 
 import numpy as np
 import pandas as pd
 
-from hpfebe.coupling import NitscheFEBE, problem
-from hpfebe.coupling.errors import be_domain_errors, be_trace_energy_error, fe_errors
+from hpfebe.analysis.rates import observed_rates
+from hpfebe.coupling.errors import lambda_sweep
 from hpfebe.results import progress
 
-log = logging.getLogger("experiments.ch2")
 logging.getLogger("skfem").setLevel(logging.WARNING)  # one INFO line per assembly otherwise
 
 PUBLISHED_COLUMNS = ["series", "h_inv", "p", "l2_error", "l2_rate", "h1_error", "h1_rate"]
+KEYS = ("series", "h_inv", "p")
 
 
 def sweep(name: str, series: str, cases, lambdas, alpha: float, h_def: str,
           desc: str = "", companions: bool = False) -> pd.DataFrame:
-    """One row per (case, lambda): cases are (fe_h_inv, be_h_inv, p) triples.
-    ``companions`` adds the BE columns be_energy (|u - U2|_W, which assembles a richer
-    W per solve) and be_h1_interp (the interpolation error of the exact u)."""
-    pb = problem(name)
+    """One row per (case, lambda_Nit) of problem ``name``: cases are (fe_h_inv,
+    be_h_inv, p) triples; columns problem, series, then those of ``lambda_sweep``."""
     rows = []
     for fh, bh, p in progress(list(cases), desc=desc or f"{name} {series}"):
-        t0 = time.perf_counter()
-        model = NitscheFEBE(pb, fh, bh, int(p), alpha=alpha, h_def=h_def)
-        t_asm = time.perf_counter() - t0
-        for lam in lambdas:
-            t1 = time.perf_counter()
-            sol = model.solve(float(lam))
-            t_solve = time.perf_counter() - t1
-            fe = fe_errors(model, sol)
-            be = be_domain_errors(model, sol)
-            row = dict(problem=name, series=series, lam=float(lam), p=int(p),
-                       fe_h_inv=fh, be_h_inv=bh, n_fe=model.n1, n_be=model.n2,
-                       dof=model.ndof, fe_l2=fe["l2"], fe_h1=fe["h1"],
-                       be_l2=be["l2"], be_h1=be["h1"], assembly_s=t_asm,
-                       solve_s=t_solve, wall_time_s=t_asm + t_solve,
-                       residual=sol.info["residual"])
-            if companions:
-                row["be_energy"] = be_trace_energy_error(model, sol)
-                row["be_h1_interp"] = be_domain_errors(model, sol,
-                                                       interpolate_exact=True)["h1"]
-            rows.append(row)
-            log.info("%s %s p=%d FE 1/%g BE 1/%g lam=%g dof=%d: FE %.3e %.3e BE %.3e %.3e "
-                     "(%.2f s + %.2f s)", name, series, p, fh, bh, lam, model.ndof,
-                     fe["l2"], fe["h1"], be["l2"], be["h1"], t_asm, t_solve)
+        rows += [dict(problem=name, series=series, **r) for r in
+                 lambda_sweep(name, fh, bh, p, lambdas, alpha, h_def, companions)]
     return pd.DataFrame(rows)
 
 
 def rates(x, e) -> np.ndarray:
-    """log(e_prev/e) / log(x/x_prev) for increasing x (h^-1 or p); NaN first."""
-    x, e = np.asarray(x, float), np.asarray(e, float)
-    r = np.full(len(e), np.nan)
-    r[1:] = np.log(e[:-1] / e[1:]) / np.log(x[1:] / x[:-1])
-    return r
+    """Observed rates w.r.t. increasing x (h^-1 or p): log(e_prev/e) / log(x/x_prev),
+    NaN first."""
+    return observed_rates(1.0 / np.asarray(x, float), np.asarray(e, float))
 
 
 def part_table(df: pd.DataFrame, part: str, h_col: str) -> pd.DataFrame:
@@ -82,7 +55,7 @@ def part_table(df: pd.DataFrame, part: str, h_col: str) -> pd.DataFrame:
                 "h1_error": gg[f"{part}_h1"], "h1_rate": rates(x, gg[f"{part}_h1"]),
                 "dof": gg["dof"], "wall_time_s": gg["wall_time_s"],
                 "fe_h_inv": gg["fe_h_inv"], "be_h_inv": gg["be_h_inv"],
-                "lambda_nit": gg["lam"]})
+                "lambda_nit": gg["lambda_nit"]})
             if part == "be" and "be_energy" in gg:
                 t["h1_interp_exact"] = gg["be_h1_interp"].to_numpy()
                 t["trace_energy_error"] = gg["be_energy"].to_numpy()
@@ -91,9 +64,16 @@ def part_table(df: pd.DataFrame, part: str, h_col: str) -> pd.DataFrame:
     return pd.concat(out, ignore_index=True)
 
 
+def last(table: pd.DataFrame, series: str, p, col: str) -> float:
+    """Last entry of ``col`` in a part table: series h at degree p, or series p."""
+    g = table[(table.series == series) & (table.p == p)] if series == "h" else \
+        table[table.series == series]
+    return float(g[col].iloc[-1])
+
+
 def compare(table: pd.DataFrame, published: pd.DataFrame, col: str) -> pd.Series:
     """reproduced / published for the rows present in both (keys series, h_inv, p)."""
-    m = table.merge(published, on=["series", "h_inv", "p"], suffixes=("", "_pub"))
+    m = table.merge(published, on=list(KEYS), suffixes=("", "_pub"))
     return m[col] / m[f"{col}_pub"]
 
 

@@ -561,12 +561,15 @@ def _claim_adaptive(errtab, label, dof_ref, last_step, beyond=False):
             f"with the same number of degrees of freedom [{label}]") if not beyond else \
         (f"(beyond the thesis: {last_step} refinement steps) the adaptive refinement "
          f"gives better results than the uniform one [{label}]")
-    claim = beats_uniform_claim(text, ad.dof, ad.err_true, un.dof, un.err_true, factor=BETTER)
+    # errors vanish for the uniform mesh that is U_190 or U_ref itself: not on log scales
+    ok = un.err_true > 0
+    claim = beats_uniform_claim(text, ad.dof, ad.err_true, un.dof[ok], un.err_true[ok],
+                                factor=BETTER)
     parts = []
     for col, name in (("err", "thesis's err(U) vs U_190"),
                       ("err_ref", "thesis's err(U) vs U_ref")):
         e_ad = float(ad[col].iloc[-1])
-        ok = un[col] > 0                 # err(U) vanishes for U_190 itself
+        ok = un[col] > 0
         if ok.sum() < 2 or not un.dof[ok].min() <= dof_last <= un.dof[ok].max():
             parts.append(f"{name}: adaptive {e_ad:.3e}, uniform n/a at this DOF")
             continue

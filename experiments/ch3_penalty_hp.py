@@ -45,13 +45,12 @@ import numpy as np
 import pandas as pd
 from matplotlib.figure import Figure
 
-from hpfebe.analysis import observed_rates
-from hpfebe.analysis.norms import energy_norm
+from hpfebe.analysis import energy_norm, fitted_rate, observed_rates
 from hpfebe.contact import solve_penalty
 from hpfebe.contact.limits import (MACHEPS, constrained_limit, saturation_index,
                                    singular_exponent, solve_penalty_checked, square_body)
 from hpfebe.params import from_config
-from hpfebe.results import ArtefactResult, Claim, progress
+from hpfebe.results import ArtefactResult, Claim, progress, rate_claim
 from hpfebe.spaces import prolongate
 
 from experiments.ch3_penalty import PUBLISHED_ULIM
@@ -304,32 +303,34 @@ def singularity_claims(rate_tab: pd.DataFrame, prm: Params, lam: float) -> list[
     hp = prm.hp_rate
     C_small, n_fin = hp.C_pen[-1], hp.n_per_side[-1]
     r_s = _final_rates(rate_tab, C_small)
-    claims = [Claim(
-        text="(beyond the thesis) the hypothesis u in H~^(3/2)(Sigma) of Theorem 3.2.6 "
-             "fails here: with the penalty error negligible, the uniform-mesh rate in h "
-             f"is the corner singularity exponent lambda = {lam:.3f} (clamped/free "
-             f"right angle, plane strain nu = {prm.nu:g}) for every p, not the h/p rate 1 "
-             "(finest rate within 0.1 of lambda)",
-        holds=bool(all(abs(v[-1] - lam) <= 0.1 for v in r_s.values())),
-        evidence=f"C = {C_small:g}: rates {_fmt(r_s)}; lambda from Williams' equation "
-                 "4 kappa sin^2(lambda pi/2) + 4 lambda^2 = (kappa + 1)^2, kappa = "
-                 f"3 - 4 nu = {3 - 4 * prm.nu:.2f}. The contact side itself is regular "
-                 "(full contact = sliding symmetry condition); the singularities sit "
-                 "at the corners of Gamma_D.")]
+    worst = max((v[-1] for v in r_s.values()), key=lambda r: abs(r - lam))
+    claim = rate_claim(
+        "(beyond the thesis) the hypothesis u in H~^(3/2)(Sigma) of Theorem 3.2.6 "
+        "fails here: with the penalty error negligible, the uniform-mesh rate in h "
+        f"is the corner singularity exponent lambda = {lam:.3f} (clamped/free "
+        f"right angle, plane strain nu = {prm.nu:g}) for every p, not the h/p rate 1 "
+        "(finest rate within 0.1 of lambda)", worst, lam, 0.1,
+        what="finest rate in h (the p farthest from lambda)")
+    claim.evidence += (f". C = {C_small:g}: rates {_fmt(r_s)}; lambda from Williams' "
+                       "equation 4 kappa sin^2(lambda pi/2) + 4 lambda^2 = (kappa + 1)^2, "
+                       f"kappa = 3 - 4 nu = {3 - 4 * prm.nu:.2f}. The contact side itself is "
+                       "regular (full contact = sliding symmetry condition); the "
+                       "singularities sit at the corners of Gamma_D.")
+    claims = [claim]
     sub = rate_tab[(rate_tab.C_pen == C_small) & (rate_tab.n_per_side == n_fin)]
     if len(sub) >= 2:
         e_p = sub.set_index("p").energy_error
         p_lo, p_hi = int(e_p.index.min()), int(e_p.index.max())
-        rp = math.log(e_p[p_lo] / e_p[p_hi]) / math.log(p_hi / p_lo)
-        claims.append(Claim(
-            text=f"(beyond the thesis) p-refinement on a fixed uniform mesh converges "
-                 f"like p^(-2 lambda) = p^(-{2 * lam:.2f}) (p-version at a node "
-                 "singularity; Theorem 3.2.6 would give p^-1): observed within 0.25",
-            holds=bool(abs(rp - 2 * lam) <= 0.25),
-            evidence=f"C = {C_small:g}, n = {n_fin}: energy error " + ", ".join(
-                f"p={p}: {e:.3e}" for p, e in e_p.items()) +
-            f"; rate in p between p={p_lo} and p={p_hi}: {rp:.2f} (p <= {p_hi} only: "
-            "pre-asymptotic)"))
+        rp = -fitted_rate([p_lo, p_hi], [e_p[p_lo], e_p[p_hi]])
+        claim = rate_claim(
+            f"(beyond the thesis) p-refinement on a fixed uniform mesh converges "
+            f"like p^(-2 lambda) = p^(-{2 * lam:.2f}) (p-version at a node "
+            "singularity; Theorem 3.2.6 would give p^-1): observed within 0.25",
+            rp, 2 * lam, 0.25, what=f"rate in p between p={p_lo} and p={p_hi}")
+        claim.evidence += (f". C = {C_small:g}, n = {n_fin}: energy error " + ", ".join(
+            f"p={p}: {e:.3e}" for p, e in e_p.items()) +
+            f" (p <= {p_hi} only: pre-asymptotic)")
+        claims.append(claim)
     return claims
 
 
@@ -494,8 +495,7 @@ def conditioning_claims(st_df: pd.DataFrame) -> list[Claim]:
         ok = g[g.cond_x_macheps < 1e-2]
         if len(ok) < 3:
             continue
-        slope_c = np.polyfit(np.log10(ok.C_eps.iloc[2:]),
-                             np.log10(ok.condition_number.iloc[2:]), 1)[0]
+        slope_c = fitted_rate(ok.C_eps.iloc[2:], ok.condition_number.iloc[2:])
         claims.append(Claim(
             text=f"Thesis (Ch. 1, 3, 4): the condition number of the Galerkin (Newton) "
                  f"matrix increases as the penalty parameter decreases [{prob}, p={p}]",

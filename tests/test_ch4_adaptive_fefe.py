@@ -1,97 +1,177 @@
-"""Tests of experiments/ch4_adaptive_fefe.py (Figures 4.13-4.16, adaptive FE/FE contact)."""
+"""Adaptive FE/FE two-body frictional contact (Section 4.2.8, Figures 4.13-4.16): the
+indicator (3.100) of each body with the contact datum, the adaptive loop on the pair of
+meshes, and the artefacts of experiments/ch4_adaptive_fefe.py through the command line."""
 
-from __future__ import annotations
-
+import json
 import math
+import subprocess
+import sys
 from pathlib import Path
 
 import meshio
 import numpy as np
+import pandas as pd
 import pytest
-import yaml
 
-from experiments import ch4_adaptive_fefe as mod
-from hpfebe.results import validate, write_result
+from hpfebe.adaptivity import (adapt, contact_traction_datum, fe_indicators, lame_stress,
+                               mark_max, two_body_indicators)
+from hpfebe.contact.two_body import TwoBodyContact
+from hpfebe.fem import is_conforming
+from hpfebe.fem.elasticity import ElasticBody, rectangle_mesh
 
 ROOT = Path(__file__).resolve().parents[1]
+E, NU = 266926.0, 0.29
+BOX_S, BOX_M = (-0.5, 0.5, 0.0, 2.0), (-2.0, 2.0, -2.0, 0.0)
+CONTACT, OPEN = ("bottom", "top"), (("left", "right"), ("left", "right"))
 
 
-def _quick_config():
-    full = yaml.safe_load((ROOT / "config" / "config.yaml").read_text())["ch4_adaptive_fefe"]
-    quick = yaml.safe_load((ROOT / "config" / "quick.yaml").read_text())["ch4_adaptive_fefe"]
-    return {**full, **quick}
+def _meshes():
+    return (rectangle_mesh(*BOX_S, 4, 8, kind="tri"), rectangle_mesh(*BOX_M, 16, 8, kind="tri"))
+
+
+def _solve(meshes):
+    """The scene of Section 4.2.8: slave top fixed, master bottom lifted by 5e-4."""
+    S, M = (ElasticBody(m, E, NU, "strain") for m in meshes)
+    pr = TwoBodyContact(S, M, ["bottom", "left", "right"], ["top", "left", "right"],
+                        eps_n=1.0 / (10 * E), eps_t=1.0 / (5 * E), mu_f=0.1)
+    top = pr.dofs_on("slave", "top")
+    bx, by = pr.dofs_on("master", "bottom", 0), pr.dofs_on("master", "bottom", 1)
+    vals = np.concatenate([np.zeros(top.size + bx.size), np.full(by.size, 5e-4)])
+    res = pr.solve(None, np.concatenate([top, bx, by]), vals,
+                   load_factors=np.arange(1, 6) / 5, rtol=1e-10, max_iter=30)
+    assert res.converged, res.reason
+    return pr, res
 
 
 @pytest.fixture(scope="module")
+def solved():
+    return _solve(_meshes())
+
+
+# ----------------------------------------------------------------------------- datum
+def test_contact_traction_datum_interpolates_on_the_labelled_facets():
+    m = rectangle_mesh(0.0, 2.0, 0.0, 1.0, 2, 2, kind="tri")
+    pts = np.array([[1.5, 0.0], [0.5, 0.0], [0.0, 0.5]])       # the last one on "left"
+    tr = np.array([[3.0, -1.0], [1.0, -2.0], [99.0, 99.0]])
+    f = contact_traction_datum(m, "bottom", pts, tr)
+    x = np.array([[0.2, 1.0, 1.9, 2.0 + 1e-3]])
+    v = f(x, np.zeros_like(x), 0 * x, -1 + 0 * x)
+    assert v.shape == (2, 1, 4)
+    np.testing.assert_allclose(v[:, 0], [[1.0, 2.0, 3.0, 0.0], [-2.0, -1.5, -1.0, 0.0]])
+    with pytest.raises(ValueError, match="label"):
+        contact_traction_datum(m, "C", pts, tr)
+    with pytest.raises(ValueError, match="shape"):
+        contact_traction_datum(m, "bottom", pts, tr[:2])
+    with pytest.raises(ValueError, match="no point"):
+        contact_traction_datum(m, "top", pts, tr)
+    with pytest.raises(ValueError, match="axis"):
+        contact_traction_datum(m, "bottom", pts, tr, axis=2)
+
+
+def test_two_body_indicators_use_the_penalty_traction(solved):
+    """Equal to fe_indicators with the datum built by hand: the penalty traction
+    p_n n_m - t_t t_m at the slave points on y = 0, linear in x, zero for |x| > 1/2,
+    its negative on the master."""
+    pr, res = solved
+    eta_s, eta_m = two_body_indicators(pr, res, contact=CONTACT, free=OPEN)
+    sel = (np.abs(res.points[:, 1]) < 1e-12) & (res.weights > 0)
+    order = np.argsort(res.points[sel, 0])
+    xs = res.points[sel, 0][order]
+    tr = (res.p_n[:, None] * pr.normals - res.t_t[:, None] * pr.tangents)[sel][order]
+    assert np.abs(tr).max() > 0          # the bodies are in contact
+
+    def f(x, y, nx, ny):
+        inside = np.abs(x) <= 0.5 + 1e-12
+        return np.array([np.where(inside, np.interp(x, xs, tr[:, c]), 0.0) for c in (0, 1)])
+
+    def zero(x, y, nx, ny):
+        return np.zeros((2,) + np.shape(x))
+
+    stress = lame_stress(E, NU, "strain")
+    ref_s = fe_indicators(pr.slave.basis, res.u_slave, stress=stress,
+                          tractions={"bottom": f, "left": zero, "right": zero})
+    ref_m = fe_indicators(pr.master.basis, res.u_master, stress=stress,
+                          tractions={"top": lambda *a: -f(*a), "left": zero, "right": zero})
+    np.testing.assert_array_equal(eta_s, ref_s)
+    np.testing.assert_array_equal(eta_m, ref_m)
+    with pytest.raises(ValueError, match="pairs"):
+        two_body_indicators(pr, res, contact=("bottom",))
+
+
+# ----------------------------------------------------------------------------- the loop
+def test_adaptive_loop_on_both_bodies():
+    def solve(meshes):
+        pr, res = _solve(meshes)
+        return (pr, res), (pr.slave.ndofs, pr.master.ndofs)
+
+    def estimate(meshes, state):
+        return two_body_indicators(*state, contact=CONTACT, free=OPEN)
+
+    meshes0 = _meshes()
+    h = adapt(meshes0, solve, estimate, n_steps=4, theta=0.9)
+    eta = h.column("eta")
+    assert eta.shape == (4, 2) and np.all(eta[-1] < eta[0])
+    assert np.all(np.diff(h.column("ndof"), axis=0) > 0)
+    for k in range(3):
+        for i in (0, 1):       # each body marked by its own maximum strategy
+            np.testing.assert_array_equal(h.marked[k][i], mark_max(h.etas[k][i], 0.9))
+    for i, m in enumerate(h.mesh):
+        assert is_conforming(m, meshes0[i])
+        assert set(m.boundaries) == {"left", "right", "bottom", "top"}
+        assert sum(len(v) for v in m.boundaries.values()) == m.boundary_facets().size
+
+
+# ----------------------------------------------------------------------------- artefacts
+@pytest.fixture(scope="module")
 def quick_run(tmp_path_factory):
-    tmp = tmp_path_factory.mktemp("results")
-    results = mod.run(_quick_config(), quick=True)
-    for r in results:
-        write_result(r, tmp)
-    return results, tmp
+    out = tmp_path_factory.mktemp("results")
+    r = subprocess.run([sys.executable, "-m", "hpfebe", "run", "figure_4_13", "--quick",
+                        "--out", str(out)], cwd=ROOT, capture_output=True, text=True,
+                       timeout=600)
+    assert r.returncode == 0, r.stderr[-3000:]
+    ids = ("figure_4_13", "figure_4_14", "figure_4_15", "figure_4_16")
+    return {i: (json.loads((out / f"{i}.json").read_text()), pd.read_csv(out / f"{i}.csv"))
+            for i in ids}, out
 
 
 def test_quick_run_produces_all_artefacts(quick_run):
-    results, tmp = quick_run
-    assert [r.name for r in results] == list(mod.ARTEFACTS)
-    for r in results:
-        validate(r)
-        assert r.figure is not None
-        assert r.claims and all(c.holds is not None for c in r.claims), r.name
-        assert r.meta["run_s"] < 20
-    vtus = sorted(p.name for p in tmp.glob("*.vtu"))
+    res, out = quick_run
+    for name, (js, _) in res.items():
+        assert (out / f"{name}.png").is_file()
+        assert js["claims"] and all(c["holds"] is not None for c in js["claims"]), name
+        assert js["meta"]["run_s"] < 60
+    vtus = sorted(p.name for p in out.glob("*.vtu"))
     assert len(vtus) == 4 and all(v.startswith("figure_4_16_") for v in vtus), vtus
-    mesh = meshio.read(tmp / vtus[0])
-    assert np.all(np.isfinite(mesh.point_data["displacement"]))
+    assert np.all(np.isfinite(meshio.read(out / vtus[0]).point_data["displacement"]))
 
 
 def test_adaptive_indicator_below_uniform_at_comparable_dof(quick_run):
-    results, _ = quick_run
-    for r, body in ((results[1], "slave"), (results[2], "master")):
-        t = r.table
+    res, _ = quick_run
+    for name, body in (("figure_4_14", "slave"), ("figure_4_15", "master")):
+        js, t = res[name]
         ad, un = t[t["mode"] == "adaptive"], t[t["mode"] == "uniform"]
         d, e = ad[f"dof_{body}"].iloc[-1], ad[f"eta_{body}"].iloc[-1]
-        # uniform meshes bracket the last adaptive DOF
         assert un[f"dof_{body}"].min() <= d <= un[f"dof_{body}"].max()
         e_u = math.exp(np.interp(math.log(d), np.log(un[f"dof_{body}"]),
                                  np.log(un[f"eta_{body}"])))
-        assert e < e_u
-        assert r.claims[0].holds is True
-        # indicator decreases along the adaptive sequence
+        assert e < e_u and js["claims"][0]["holds"] is True
         assert ad[f"eta_{body}"].iloc[-1] < ad[f"eta_{body}"].iloc[0]
+        assert (un[f"marked_{body}"] == 0).all() and (ad[f"marked_{body}"].iloc[:-1] > 0).all()
 
 
-def test_newton_converges_every_step(quick_run):
-    results, _ = quick_run
-    t = results[1].table
-    assert t["newton_converged"].all()
+def test_newton_converges_and_meshes_conform(quick_run):
+    res, _ = quick_run
+    js, t = res["figure_4_14"]
+    assert t["newton_converged"].all() and js["meta"]["newton_all_converged"]
     for s in t["newton_per_load_step"]:
         its = [int(i) for i in s.split()]
         assert len(its) >= 5 and max(its) <= 10
-    assert results[1].meta["newton_all_converged"]
-
-
-def test_meshes_conforming_and_labelled(quick_run):
-    results, _ = quick_run
-    assert results[0].table["conforming"].all()
-    assert results[0].table["h_min_slave"].iloc[-1] < results[0].table["h_min_slave"].iloc[0]
-
-
-def test_refine_keeps_conformity_and_relabels():
-    m = mod.label(mod.rectangle_mesh(*mod.BOX_M, 4, 2, kind="tri"), mod.BOX_M)
-    marked = np.zeros(m.t.shape[1], bool)
-    marked[:3] = True
-    r = mod.refine(m, mod.BOX_M, marked)
-    assert r.t.shape[1] > m.t.shape[1]
-    assert mod.is_conforming(r, mod.BOX_M)
-    total = sum(len(v) for v in r.boundaries.values())
-    assert total == r.boundary_facets().size
-    top = r.p[:, r.facets[:, r.boundaries["top"]].ravel()]
-    assert np.allclose(top[1], 0.0)
+    t13 = res["figure_4_13"][1]
+    assert t13["conforming"].all()
+    assert t13["h_min_slave"].iloc[-1] < t13["h_min_slave"].iloc[0]
 
 
 def test_displacement_between_dirichlet_values(quick_run):
-    results, _ = quick_run
-    t = results[3].table
+    js, t = quick_run[0]["figure_4_16"]
     assert t["uy_min"].min() >= -1e-12 and t["uy_max"].max() <= 5e-4 * (1 + 1e-9)
-    assert results[3].claims[0].holds is True
+    assert js["claims"][0]["holds"] is True

@@ -36,6 +36,28 @@ def _consts(plane="strain"):
     return lam, mu, c1, c2, Ep
 
 
+def test_kernel_params_layout_by_name():
+    """kp of the Lame kernels is read by the named indices KP_* of bem.kernels."""
+    from hpfebe.bem import kernels as k
+    from hpfebe.bem.lame import kernel_params
+    from hpfebe.materials import plane_modulus
+
+    names = ("KP_C1_LOG_R", "KP_C1_C2", "KP_LAMBDA", "KP_MU", "KP_C1", "KP_C2",
+             "KP_ET_LOG_R", "KP_ET")
+    assert sorted(getattr(k, n) for n in names) == list(range(k.KP_LAME_SIZE))
+    for plane in ("strain", "stress"):
+        lam, mu, c1, c2, Ep = _consts(plane)
+        kp = kernel_params(lam, mu, 3.0)
+        assert kp.shape == (k.KP_LAME_SIZE,)
+        assert kp[k.KP_LAMBDA] == lam and kp[k.KP_MU] == mu
+        Et = plane_modulus(E, NU, plane) / (4 * math.pi)
+        np.testing.assert_allclose(
+            kp[[k.KP_C1, k.KP_C2, k.KP_C1_LOG_R, k.KP_C1_C2, k.KP_ET, k.KP_ET_LOG_R]],
+            [c1, c2, c1 * math.log(3.0), c1 * c2, Et, Et * math.log(3.0)], rtol=1e-14)
+        bem = LameBEM(BoundaryMesh.polygon([(0, 0), (1, 0), (0, 1)], n=1, p=1), E, NU, plane)
+        assert bem.c1 == pytest.approx(c1, rel=1e-14) and bem.Et == pytest.approx(Et, rel=1e-14)
+
+
 def ref_kernel(op, r, ny, plane="strain"):
     """Full kernel (..., 2, 2) at r = x - y (scale R = 1), written independently:
     G, its y-traction (from the Kelvin gradient) and the Maue-type kernel of W."""

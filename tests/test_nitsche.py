@@ -13,17 +13,18 @@ from hpfebe.analysis.rates import observed_rates
 from hpfebe.coupling import SINGULAR, SMOOTH, NitscheFEBE, problem
 from hpfebe.coupling.coercivity import (coercivity_threshold, inverse_constant,
                                         lemma_2_2_3_bound)
-from hpfebe.coupling.errors import (_graded_corner_rule, be_domain_errors,
-                                    be_trace_energy_error, fe_errors)
+from hpfebe.coupling.errors import (_graded_corner_rule, be_domain_errors, be_solution_at,
+                                    be_trace_energy_error, boundary_values, fe_errors,
+                                    lambda_sweep)
 from hpfebe.coupling.interface import common_refinement, interface_rule
 from hpfebe.fem import PoissonFE, block_grid
 
 PUBLISHED = "report/published/"
 
 
-def solve(pb, fh, bh, p, lam=10.0, **kw):
+def solve(pb, fh, bh, p, lambda_nit=10.0, **kw):
     model = NitscheFEBE(pb, fh, bh, p, **kw)
-    sol = model.solve(lam)
+    sol = model.solve(lambda_nit)
     return model, sol, fe_errors(model, sol), be_domain_errors(model, sol)
 
 
@@ -120,7 +121,7 @@ def test_smooth_h_version_fe_rates(p):
     """Nested non-matching meshes FE h^-1 = 4, 8, 16 / BE h^-1 = 5, 10, 20 (the thesis's
     2, 5, 11, 23 sequence is not nested and its rates scatter by 0.2-0.4);
     lambda_Nit = 20 (above the coercivity threshold for p <= 3, see below)."""
-    errs = [solve(SMOOTH, fh, bh, p, lam=20.0)[2] for fh, bh in [(4, 5), (8, 10), (16, 20)]]
+    errs = [solve(SMOOTH, fh, bh, p, lambda_nit=20.0)[2] for fh, bh in [(4, 5), (8, 10), (16, 20)]]
     h = np.array([1 / 4, 1 / 8, 1 / 16])
     r_l2 = observed_rates(h, np.array([e["l2"] for e in errs]))
     r_h1 = observed_rates(h, np.array([e["h1"] for e in errs]))
@@ -205,27 +206,59 @@ def test_graded_corner_rule_integrates_the_corner_singularity():
 
 # ----------------------------------------------------------------------- lambda_Nit
 def test_lambda_below_threshold_breaks_convergence_above_it_does_not_matter():
-    """p = 1: lambda = 1 is below lam* (about 1.1); lambda = 10 and 20 are above."""
+    """p = 1: lambda = 1 is below lambda* (about 1.1); lambda = 10 and 20 are above."""
     meshes = [(4, 5), (8, 10), (16, 20)]
-    e1 = np.array([solve(SMOOTH, fh, bh, 1, lam=1.0)[2]["h1"] for fh, bh in meshes])
-    e10 = np.array([solve(SMOOTH, fh, bh, 1, lam=10.0)[2]["h1"] for fh, bh in meshes])
-    e20 = np.array([solve(SMOOTH, fh, bh, 1, lam=20.0)[2]["h1"] for fh, bh in meshes])
+    e1 = np.array([solve(SMOOTH, fh, bh, 1, lambda_nit=1.0)[2]["h1"] for fh, bh in meshes])
+    e10 = np.array([solve(SMOOTH, fh, bh, 1, lambda_nit=10.0)[2]["h1"] for fh, bh in meshes])
+    e20 = np.array([solve(SMOOTH, fh, bh, 1, lambda_nit=20.0)[2]["h1"] for fh, bh in meshes])
     r1 = observed_rates(1 / np.array([4.0, 8.0, 16.0]), e1)
     assert r1[-1] < 0.5 or np.all(e1 > 2 * e10), (r1, e1 / e10)
     np.testing.assert_allclose(e10, e20, rtol=0.05)
 
 
 def test_coercivity_threshold_grows_like_p_squared_for_alpha_0():
-    lam = [coercivity_threshold(NitscheFEBE(SMOOTH, 5, 6, p)) for p in (1, 2, 3)]
-    assert lam[0] < lam[1] < lam[2]
-    assert 1.0 < lam[0] < 5.0 and 5.0 < lam[2]     # the thesis's lambda = 1 / 5 observations
-    # alpha only rescales the penalty: lam*(alpha) = lam*(0) p^-alpha
-    lam2 = coercivity_threshold(NitscheFEBE(SMOOTH, 5, 6, 3, alpha=2.0))
-    assert lam2 == pytest.approx(lam[2] / 9.0, rel=1e-8)
+    star = [coercivity_threshold(NitscheFEBE(SMOOTH, 5, 6, p)) for p in (1, 2, 3)]
+    assert star[0] < star[1] < star[2]
+    assert 1.0 < star[0] < 5.0 and 5.0 < star[2]   # the thesis's lambda = 1 / 5 observations
+    # alpha only rescales the penalty: lambda*(alpha) = lambda*(0) p^-alpha
+    star2 = coercivity_threshold(NitscheFEBE(SMOOTH, 5, 6, 3, alpha=2.0))
+    assert star2 == pytest.approx(star[2] / 9.0, rel=1e-8)
     # the computed threshold respects the sufficient condition of Lemma 2.2.3
     model = NitscheFEBE(SMOOTH, 5, 6, 3)
     C = inverse_constant(model)
-    assert lam[2] <= C * 9 * (1 + 1e-8) < lemma_2_2_3_bound(3, 0.0, C)
+    assert star[2] <= C * 9 * (1 + 1e-8) < lemma_2_2_3_bound(3, 0.0, C)
+
+
+def test_lambda_sweep_rows_equal_separate_solves():
+    rows = lambda_sweep("smooth", 2, 3, 2, [5.0, 20.0], companions=True)
+    assert [r["lambda_nit"] for r in rows] == [5.0, 20.0]
+    for r in rows:
+        model, sol, fe, be = solve(SMOOTH, 2, 3, 2, lambda_nit=r["lambda_nit"])
+        assert (r["fe_l2"], r["fe_h1"], r["be_l2"], r["be_h1"]) == (
+            fe["l2"], fe["h1"], be["l2"], be["h1"])
+        assert r["dof"] == model.ndof and r["residual"] < 1e-12
+        assert r["be_energy"] == be_trace_energy_error(model, sol)
+        assert r["wall_time_s"] == r["assembly_s"] + r["solve_s"]
+    assert "be_energy" not in lambda_sweep(SMOOTH, 2, 3, 1, 10.0)[0]
+    with pytest.raises(ValueError, match="lambda_Nit"):
+        lambda_sweep("smooth", 2, 3, 1, [-1.0])
+    with pytest.raises(ValueError, match="lambdas"):
+        lambda_sweep("smooth", 2, 3, 1, [])
+
+
+def test_be_solution_on_the_boundary_is_U2_inside_the_representation():
+    model, sol = solve(SMOOTH, 5, 6, 2)[:2]
+    mesh = model.be_mesh
+    on = mesh.points(np.arange(mesh.n_elements), np.full(mesh.n_elements, 0.3))
+    inside = np.array([[-0.5, 0.0], [-0.25, 0.1]])                 # points of Omega2
+    v = boundary_values(model, sol.U2, np.vstack([on, inside]))
+    np.testing.assert_allclose(
+        v[:len(on)], model.bem.V_space.evaluate(sol.U2, np.arange(mesh.n_elements),
+                                                np.full(mesh.n_elements, 0.3)),
+        rtol=1e-14, atol=1e-16)
+    assert np.isnan(v[len(on):]).all()
+    u = be_solution_at(model, sol.U2, inside)
+    np.testing.assert_allclose(u, SMOOTH.u(inside[:, 0], inside[:, 1]), rtol=2e-3)
 
 
 def test_solver_reports_residual():

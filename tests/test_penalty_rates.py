@@ -11,8 +11,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from hpfebe.analysis import aitken, observed_rates
-from hpfebe.analysis.norms import energy_norm
+from hpfebe.analysis import aitken, energy_norm, observed_rates
 from hpfebe.contact import solve_penalty
 from hpfebe.contact.limits import (MACHEPS, constrained_limit, solve_penalty_checked,
                                    square_body)

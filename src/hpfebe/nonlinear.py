@@ -156,7 +156,8 @@ def newton(problem: NewtonProblem, x0: np.ndarray, tol: float, max_iter: int = 5
             return it, info
         xmax = np.abs(it.x).max(initial=0.0)
         if roundoff_stop and np.abs(dx).max(initial=0.0) <= 64 * EPS * xmax:
-            info.converged = True
+            # the k-th Newton system was solved (and counts), its update is not taken
+            info.iterations, info.converged = k, True
             info.reason = ("converged (Newton update at round-off level; the residual is "
                            "limited by the conditioning)")
             return it, info

@@ -14,7 +14,8 @@ name.  The JSON file is written last, so a result is complete when its JSON exis
 Claims that recur are built by helpers, so that the verdict and its evidence read the
 same everywhere: :func:`rate_claim` (an observed rate against the expected one),
 :func:`beats_uniform_claim` (adaptive against uniform refinement at equal DOF) and
-:func:`range_claim` (a computed range against a published one, e.g. a colorbar).
+:func:`range_claim` (a computed range against a published one, e.g. a colorbar), and
+:func:`joint_claim` (one statement made of several checked parts).
 
 This is an edge module: no numerics (the log-log interpolation is
 :func:`hpfebe.analysis.rates.loglog_interpolate`), only data containers, claims and
@@ -44,6 +45,7 @@ __all__ = [
     "rate_claim",
     "beats_uniform_claim",
     "range_claim",
+    "joint_claim",
     "ArtefactResult",
     "write_result",
     "read_result",
@@ -146,6 +148,18 @@ def range_claim(statement: str, name: str, ours, published, rel_tol: float) -> C
                  f"{name} {lo:.4e}..{hi:.4e} (published {plo:.4e}..{phi:.4e}): largest "
                  f"deviation {100 * dev:.1f} % of the published span (tolerance "
                  f"{100 * rel_tol:g} %)")
+
+
+def joint_claim(statement: str, *parts: Claim, note: str = "") -> Claim:
+    """One statement that holds iff every part holds: False if any part is False, else
+    None if any is undecidable, else True; the evidence joins the parts' evidence
+    (``"; "``) and ``note``."""
+    if not parts or not all(isinstance(c, Claim) for c in parts):
+        raise ValueError("joint_claim needs at least one Claim part")
+    verdicts = [c.holds for c in parts]
+    holds = False if False in verdicts else (None if None in verdicts else True)
+    evidence = "; ".join(c.evidence for c in parts if c.evidence)
+    return Claim(statement, holds, evidence + (f" ({note})" if note else ""))
 
 
 @dataclass

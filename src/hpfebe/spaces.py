@@ -13,7 +13,12 @@ Reference element: ``t`` in [-1, 1], mapped affinely onto ``I = [a_I, b_I]``
 
 Global numbering of V_hp: vertex functions first (in node order), then the interior
 functions element by element.  ``elem_dofs[e, j]`` is the global index of local function
-j on element e, -1 for padding or for a function removed by ``zero_on``.
+j on element e, -1 for padding or for a function removed by ``zero_on``.  Vector fields
+(V_hp^2, W_hp^2) interleave the components: dof 2 d + c.
+
+Basis values at points: :meth:`_Space.trace_matrix` (sparse, scalar or interleaved
+vector).  Nested meshes: :func:`prolongate` writes a function of a coarse mesh exactly in
+the space of a refinement (parent maps of :meth:`BoundaryMesh.refine`, or geometry).
 """
 
 from __future__ import annotations

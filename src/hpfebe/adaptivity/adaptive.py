@@ -38,6 +38,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..fem.meshes import refine_labelled
 from .marking import MARKERS
 
 log = logging.getLogger(__name__)
@@ -50,8 +51,6 @@ def default_refine(mesh, marked):
     scikit-fem mesh :func:`hpfebe.fem.meshes.refine_labelled` (labels kept)."""
     marked = np.asarray(marked, dtype=bool)
     if hasattr(mesh, "refined") and not hasattr(mesh, "refine"):
-        from ..fem.meshes import refine_labelled
-
         return refine_labelled(mesh, marked)
     return mesh.refine(marked)
 

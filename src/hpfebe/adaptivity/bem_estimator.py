@@ -1,6 +1,10 @@
 """Residual a posteriori error estimate for the Galerkin BEM (Section 3.3.3).
 
-Laplace (below) and Lame (end of the module, same indicator with vector residuals).
+Laplace (below), Lame (same indicator with vector residuals), and the contact part of
+Section 3.3.5 (end of the module): the datum P_n n + P_t t of (3.107) from the penalty
+law of :mod:`hpfebe.contact.laws`, the indicator with a weighted consistency term,
+|||U|||_B of a discrete penalty solution, and the error |||U_ref - U|||_B against a
+reference on a nested finer mesh.
 
 Setting (3.90)/(3.95) without contact: U in V_hp, U = 0 on Gamma_D (the space
 H~^(1/2)(Sigma), Sigma = Gamma minus Gamma_D), <S_hat U, V> = <t_hat, V>_{Gamma_N}, and the
@@ -102,18 +106,24 @@ def solve_laplace_mixed(op, flux, dirichlet=("D",)):
     return U, op.Psi(U)
 
 
+def _residual_points(mesh, nq):
+    """(elem, t, w): the graded rule with ``nq`` points (default p_max + 3) on every
+    element, w the weights of ds."""
+    if nq is None:
+        nq = int(mesh.degrees.max()) + 3
+    tq, wq = graded_rule(nq)
+    ne = mesh.n_elements
+    elem = np.repeat(np.arange(ne), len(tq))
+    return elem, np.tile(tq, ne), np.tile(wq, ne) * mesh.lengths[elem] / 2.0
+
+
 def boundary_residuals(op, U, Psi, nq: int | None = None):
     """S_hat U and d/ds (V Psi - (K + 1/2) U) at graded quadrature points of every element.
 
     Returns dict with elem, t, x, n, w (weights of ds), SU, dres."""
     mesh = op.mesh
     W = op.W_space
-    if nq is None:
-        nq = int(mesh.degrees.max()) + 3
-    tq, wq = graded_rule(nq)
-    ne = mesh.n_elements
-    elem = np.repeat(np.arange(ne), len(tq))
-    t = np.tile(tq, ne)
+    elem, t, w = _residual_points(mesh, nq)
     dU = op.T @ np.asarray(U, dtype=float)        # W_hp coefficients of dU/ds (exact)
     gU = grad_single_layer_on_gamma(W, dU, elem, t)
     gP = grad_single_layer_on_gamma(W, Psi, elem, t)
@@ -123,7 +133,7 @@ def boundary_residuals(op, U, Psi, nq: int | None = None):
     SU = -np.sum(gU * tan, 1) + np.sum(gP * nrm, 1) + 0.5 * Psi_x
     dres = np.sum(gP * tan, 1) + np.sum(gU * nrm, 1) - 0.5 * dU_x
     return dict(elem=elem, t=t, x=mesh.points(elem, t), n=nrm,
-                w=np.tile(wq, ne) * mesh.lengths[elem] / 2.0, SU=SU, dres=dres)
+                w=w, SU=SU, dres=dres)
 
 
 def bem_indicators(op, U, Psi, tractions: dict, nq: int | None = None,
@@ -187,12 +197,7 @@ def error_measure_B(op, U, Psi, u_exact, flux_exact, extra: int = 3) -> float:
 def lame_boundary_residuals(op, U, Psi, nq: int | None = None, delta: float = 1e-5):
     """Lame analogue of :func:`boundary_residuals`: SU (n, 2) and dres (n, 2)."""
     mesh = op.mesh
-    if nq is None:
-        nq = int(mesh.degrees.max()) + 3
-    tq, wq = graded_rule(nq)
-    ne = mesh.n_elements
-    elem = np.repeat(np.arange(ne), len(tq))
-    t = np.tile(tq, ne)
+    elem, t, w = _residual_points(mesh, nq)
     tan, nrm = mesh.tangents[elem], mesh.normals[elem]
     x = mesh.points(elem, t)
     xin = x - delta * mesh.lengths[elem, None] * nrm
@@ -203,7 +208,7 @@ def lame_boundary_residuals(op, U, Psi, nq: int | None = None, delta: float = 1e
     dU_x = op.W_space.evaluate(dU, elem, t)                   # (n, 2)
     SU = np.einsum("qij,qj->qi", S, nrm)
     dres = np.einsum("qim,qm->qi", G, tan) - dU_x
-    return dict(elem=elem, t=t, x=x, n=nrm, w=np.tile(wq, ne) * mesh.lengths[elem] / 2.0,
+    return dict(elem=elem, t=t, x=x, n=nrm, w=w,
                 SU=SU, dres=dres)
 
 

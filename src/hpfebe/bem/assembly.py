@@ -62,6 +62,23 @@ def _scratch(nmax, pmax, d):
             np.empty(64 * nmax), np.empty((128, 4)))
 
 
+@njit(cache=True, inline="always")
+def _scatter(blk, dofs_i, dofs_j, mt, mr, d, out):
+    """out[dof_k, dof_l] += blk[k, l] (interleaved components) for the local block of a
+    test and a trial element with global dofs dofs_i, dofs_j (-1: none)."""
+    for k in range(mt):
+        gk = dofs_i[k]
+        if gk < 0:
+            continue
+        for l in range(mr):
+            gl = dofs_j[l]
+            if gl < 0:
+                continue
+            for c1 in range(d):
+                for c2 in range(d):
+                    out[gk * d + c1, gl * d + c2] += blk[k * d + c1, l * d + c2]
+
+
 @njit(cache=True, parallel=True)
 def _assemble(kernel, logc, haslog, kp, d, nodes, elements, normals,
               kt, degt, dofs_t, kr, degr, dofs_r, symmetric,
@@ -151,18 +168,7 @@ def _assemble(kernel, logc, haslog, kp, d, nodes, elements, normals,
             else:
                 _pair_block(kernel, logc, haslog, kp, d, nodes, elements, normals, i, j,
                             kt, pt, kr, pr, gx, gw, lx, lw, gll_x, gll_b, scratch, blk)
-            for k in range(mt):
-                gk = dofs_t[i, k]
-                if gk < 0:
-                    continue
-                for l in range(mr):
-                    gl = dofs_r[j, l]
-                    if gl < 0:
-                        continue
-                    for c1 in range(d):
-                        for c2 in range(d):
-                            v = blk[k * d + c1, l * d + c2]
-                            out[gk * d + c1, gl * d + c2] += v
+            _scatter(blk, dofs_t[i], dofs_r[j], mt, mr, d, out)
     if symmetric:
         # dofs of W_hp grow with the element index, so the pairs j >= i filled the upper
         # triangle; mirror it in cache-sized tiles (a column-wise mirror inside the pair

@@ -7,8 +7,9 @@ for a potential kernel given by an integer id (``POT_*`` below, dispatched by
 cannot hold functions specialised on function-typed arguments) that writes the full
 (nout x d) kernel matrix row-major (out[a * d + c]), r = x - y, log part included.
 Each element is bisected until the point is at least one sub-element length away, then
-Gauss with an order that grows with log(size / distance) (the rule of :func:`hpfebe.bem.integration._order`), so the
-accuracy holds uniformly up to (not on) the boundary.
+Gauss with an order that grows with log(size / distance) (the rule of
+:func:`hpfebe.bem.integration._order`), so the accuracy holds uniformly up to (not on)
+the boundary.
 """
 
 from __future__ import annotations

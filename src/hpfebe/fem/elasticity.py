@@ -8,9 +8,10 @@ with the modified lambda*).
 Dof numbering is scikit-fem's: ``basis.nodal_dofs[c, i]`` is component c (0 = x, 1 = y) at
 vertex i (interleaved, 2 i + c, for these elements).
 
-A body is built from a mesh whose boundary facets carry labels (``mesh.boundaries``);
-:func:`rectangle_mesh` labels the four sides of a rectangle "left", "right", "bottom",
-"top" by position.
+A body is built from a mesh whose boundary facets carry labels (``mesh.boundaries``, the
+labelled meshes of :mod:`hpfebe.fem.meshes`, also as an :class:`~hpfebe.fem.meshes.FEDomain`;
+:func:`~hpfebe.fem.meshes.refine_labelled` keeps the labels); :func:`rectangle_mesh`
+labels the four sides of a rectangle "left", "right", "bottom", "top" by position.
 """
 
 from __future__ import annotations
@@ -32,6 +33,7 @@ from skfem import (
 from skfem.models.elasticity import linear_elasticity
 
 from ..materials import lame_constants
+from .meshes import FEDomain
 
 KINDS = ("quad", "tri")
 
@@ -68,11 +70,14 @@ def rectangle_mesh(
 class ElasticBody:
     """A linearly elastic FE body: mesh, vector P1/Q1 basis, stiffness matrix ``K``.
 
-    Parameters: ``mesh`` (skfem MeshTri or MeshQuad with labelled ``boundaries``),
-    ``E`` (Young's modulus), ``nu`` (Poisson ratio), ``plane`` ("strain" or "stress").
+    Parameters: ``mesh`` (skfem MeshTri or MeshQuad with labelled ``boundaries``, or an
+    :class:`~hpfebe.fem.meshes.FEDomain`), ``E`` (Young's modulus), ``nu`` (Poisson
+    ratio), ``plane`` ("strain" or "stress").
     """
 
     def __init__(self, mesh, E: float, nu: float, plane: str = "strain"):
+        if isinstance(mesh, FEDomain):
+            mesh = mesh.mesh
         if isinstance(mesh, MeshQuad):
             elem = ElementQuad1()
         elif isinstance(mesh, MeshTri):

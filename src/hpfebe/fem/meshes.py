@@ -41,7 +41,7 @@ from __future__ import annotations
 
 import logging
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Callable, Sequence
 
 import numpy as np
@@ -77,15 +77,29 @@ def block_grid(breaks: Sequence[float], h_inv: float, rounding: str = "floor") -
 
 @dataclass(frozen=True)
 class FEDomain:
-    """A quadrilateral mesh with labelled boundary facets.
+    """A labelled mesh and the nominal inverse mesh size ``h_inv`` it was built for.
 
-    ``facets[label]`` are the boundary facet indices of ``mesh`` carrying ``label``
-    ("D", "N", "I", ...).  ``h_inv`` is the nominal inverse mesh size it was built for.
+    The labels are the mesh's own named boundaries (scikit-fem ``mesh.boundaries``, the
+    one labelled-mesh notion of the package, kept by :func:`refine_labelled`):
+    ``facets[label]`` are the boundary facet indices carrying ``label`` ("D", "N", "I",
+    ...), and ``facets`` is ``mesh.boundaries`` itself (labels given as ``facets`` are
+    attached to the mesh).
     """
 
     mesh: MeshQuad
-    facets: dict
-    h_inv: float
+    facets: dict | None = None
+    h_inv: float = math.nan
+
+    def __post_init__(self):
+        if not (hasattr(self.mesh, "p") and hasattr(self.mesh, "facets")):
+            raise ValueError(f"mesh must be a scikit-fem mesh, got {type(self.mesh).__name__}")
+        mesh = self.mesh
+        if self.facets is not None and self.facets is not mesh.boundaries:
+            mesh = replace(mesh, _boundaries=dict(self.facets))
+        elif mesh.boundaries is None:
+            mesh = replace(mesh, _boundaries={})
+        object.__setattr__(self, "mesh", mesh)
+        object.__setattr__(self, "facets", mesh.boundaries)
 
     @property
     def n_elements(self) -> int:

@@ -16,7 +16,8 @@ from functools import cached_property
 
 import numpy as np
 import scipy.sparse as sp
-from skfem import Basis, BilinearForm, ElementQuad1, ElementQuadP, FacetBasis, Functional
+from skfem import (Basis, BilinearForm, ElementQuad1, ElementQuadP, FacetBasis, Functional,
+                   MeshQuad)
 from skfem import LinearForm, asm
 from skfem.helpers import dot, grad
 
@@ -47,15 +48,19 @@ def quad_element(p: int):
 
 
 class PoissonFE:
-    """Q_p finite elements on an :class:`FEDomain` with u = 0 on the facets ``dirichlet``.
+    """Q_p finite elements on an :class:`FEDomain` (or a labelled rectangle ``MeshQuad``)
+    with u = 0 on the facets ``dirichlet``.
 
     Attributes: ``basis`` (skfem CellBasis), ``ndof``, ``free`` (dofs not on Gamma_D),
-    ``A`` (stiffness, all dofs, assembled once).
+    ``K`` (stiffness, all dofs, assembled once; the name of every FE body's stiffness).
     """
 
     def __init__(self, domain: FEDomain, p: int, dirichlet: tuple[str, ...] = ("D",)):
+        if isinstance(domain, MeshQuad):
+            domain = FEDomain(domain)
         if not isinstance(domain, FEDomain):
-            raise ValueError(f"domain must be an FEDomain, got {type(domain).__name__}")
+            raise ValueError(f"domain must be an FEDomain or a MeshQuad, got "
+                             f"{type(domain).__name__}")
         self.domain = domain
         self.p = int(p)
         self.element = quad_element(p)
@@ -70,8 +75,12 @@ class PoissonFE:
         mask[self.fixed] = False
         self.free = np.flatnonzero(mask)
 
+    @property
+    def mesh(self):
+        return self.domain.mesh
+
     @cached_property
-    def A(self) -> sp.csr_matrix:
+    def K(self) -> sp.csr_matrix:
         """Stiffness matrix (grad U, grad V)_Omega1, all dofs."""
         return asm(laplace, self.basis).tocsr()
 
