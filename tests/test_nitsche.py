@@ -267,3 +267,14 @@ def test_solver_reports_residual():
     assert sol.info["residual"] < 1e-12
     with pytest.raises(ValueError, match="lambda_Nit"):
         model.solve(-1.0)
+
+
+def test_solve_returns_solver_info():
+    """The Nitsche solve reports through the one SolverInfo of hpfebe.nonlinear."""
+    from hpfebe.coupling.examples import problem
+    from hpfebe.coupling.nitsche import NitscheFEBE
+    from hpfebe.nonlinear import SolverInfo
+
+    sol = NitscheFEBE(problem("smooth"), 2, 3, 1).solve()
+    assert isinstance(sol.solver, SolverInfo) and sol.solver.converged
+    assert sol.solver.residuals[-1] == sol.info["residual"] <= 1e-10

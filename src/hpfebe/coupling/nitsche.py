@@ -53,6 +53,7 @@ import scipy.sparse.linalg as spla
 from ..bem import LaplaceBEM
 from ..fem.poisson import PoissonFE
 from ..quadrature import gauss_legendre
+from ..nonlinear import SolverInfo
 from .examples import InterfaceProblem
 from .interface import interface_rule
 
@@ -66,12 +67,15 @@ DEFAULT_H_DEF = "edge"
 @dataclass
 class NitscheSolution:
     """Solution of (2.3): U1 (FE, all dofs of ``fe``), U2 (BE, all dofs of ``V_space``),
-    and solver diagnostics (``info``: residual, timings, sizes)."""
+    and diagnostics (``info``: residual, timings, sizes; ``solver``: the
+    :class:`hpfebe.nonlinear.SolverInfo` of the direct solve, residuals relative to the
+    right-hand side)."""
 
     lambda_nit: float
     U1: np.ndarray
     U2: np.ndarray
     info: dict = field(default_factory=dict)
+    solver: SolverInfo | None = None
 
 
 class NitscheFEBE:
@@ -222,4 +226,6 @@ class NitscheFEBE:
         full2[self.free2] = U2
         info = {"residual": res, "solve_s": time.perf_counter() - t0, "n_fe": self.n1,
                 "n_be": self.n2, **self.timings}
-        return NitscheSolution(float(lambda_nit), full1, full2, info)
+        solver = SolverInfo(True, "converged (sparse LU, relative residual checked)", 1,
+                            [1.0, res])
+        return NitscheSolution(float(lambda_nit), full1, full2, info, solver)
