@@ -119,13 +119,29 @@ def _smooth_claims(lambda_nit, d, ref, degrees) -> list[Claim]:
     return []
 
 
-def smooth_figures(prm: Params, sm: pd.DataFrame) -> list[ArtefactResult]:
-    """Figures 2.5-2.8: Example 1, h-version, errors against 1/h, one lambda_Nit each."""
-    ref = sm[sm.lambda_nit == max(prm.lambdas)]
+def _per_lambda(prm: Params, df: pd.DataFrame, first: int, title: str, xlabel: str,
+                draw, claims, notes: str) -> list[ArtefactResult]:
+    """One figure per lambda_Nit (figure_2_<first + k>): ``draw(ax, d)`` plots the rows
+    ``d`` of that lambda, ``claims(lambda_nit, d, ref)`` states the claims against the
+    largest lambda."""
+    ref = df[df.lambda_nit == max(prm.lambdas)]
     out = []
     for k, lambda_nit in enumerate(prm.lambdas):
-        d = sm[sm.lambda_nit == lambda_nit]
-        fig, ax = _figure(f"Example 1, h-version, lambda_Nit = {lambda_nit:g}", "1/h")
+        d = df[df.lambda_nit == lambda_nit]
+        fig, ax = _figure(f"{title}, lambda_Nit = {lambda_nit:g}", xlabel)
+        draw(ax, d)
+        ax.legend(fontsize=6, ncol=2)
+        out.append(ArtefactResult(
+            name=f"figure_2_{first + k}", table=d.reset_index(drop=True), figure=fig,
+            claims=claims(lambda_nit, d, ref),
+            meta=dict(alpha=prm.alpha, h_def=prm.h_def, lambdas=list(prm.lambdas)),
+            notes=notes + " Choices: " + " ".join(CHOICES)))
+    return out
+
+
+def smooth_figures(prm: Params, sm: pd.DataFrame) -> list[ArtefactResult]:
+    """Figures 2.5-2.8: Example 1, h-version, errors against 1/h, one lambda_Nit each."""
+    def draw(ax, d):
         for p in prm.degrees:
             g = d[d.p == p].sort_values("fe_h_inv")
             for part, hcol in (("be", "be_h_inv"), ("fe", "fe_h_inv")):
@@ -133,14 +149,10 @@ def smooth_figures(prm: Params, sm: pd.DataFrame) -> list[ArtefactResult]:
                     ax.loglog(g[hcol], g[f"{part}_{norm}"], "o-" if part == "fe" else "s--",
                               ms=3, label=f"{nm} ({part.upper()}, p={p})")
             add_slope(ax, g.fe_h_inv, g.fe_h1.iloc[0], -p, f"h^{p}")
-        ax.legend(fontsize=6, ncol=2)
-        out.append(ArtefactResult(
-            name=f"figure_2_{5 + k}", table=d.reset_index(drop=True), figure=fig,
-            claims=_smooth_claims(lambda_nit, d, ref, prm.degrees),
-            meta=dict(alpha=prm.alpha, h_def=prm.h_def, lambdas=list(prm.lambdas)),
-            notes="Errors against 1/h (FE h^-1 for FE curves, BE h^-1 for BE curves). "
-                  "Choices: " + " ".join(CHOICES)))
-    return out
+
+    return _per_lambda(prm, sm, 5, "Example 1, h-version", "1/h", draw,
+                       lambda lam, d, ref: _smooth_claims(lam, d, ref, prm.degrees),
+                       "Errors against 1/h (FE h^-1 for FE curves, BE h^-1 for BE curves).")
 
 
 # ----------------------------------------------------------------------------- singular
@@ -166,11 +178,7 @@ def _singular_claim(lambda_nit, d, sref) -> Claim:
 
 def singular_figures(prm: Params, sg: pd.DataFrame) -> list[ArtefactResult]:
     """Figures 2.9-2.12: Example 2, h- and p-version, errors against DOF."""
-    sref = sg[sg.lambda_nit == max(prm.lambdas)]
-    out = []
-    for k, lambda_nit in enumerate(prm.lambdas):
-        d = sg[sg.lambda_nit == lambda_nit]
-        fig, ax = _figure(f"Example 2, h- and p-version, lambda_Nit = {lambda_nit:g}", "DOF")
+    def draw(ax, d):
         for series, mk in (("h", "o-"), ("p", "s--")):
             g = d[d.series == series].sort_values("dof")
             for part in ("be", "fe"):
@@ -179,15 +187,11 @@ def singular_figures(prm: Params, sg: pd.DataFrame) -> list[ArtefactResult]:
                               label=f"{series}: {nm} ({part.upper()})")
         gh = d[d.series == "h"].sort_values("dof")
         add_slope(ax, gh.dof, gh.be_h1.iloc[0], -1 / 3, "DOF^-1/3")
-        ax.legend(fontsize=6, ncol=2)
-        out.append(ArtefactResult(
-            name=f"figure_2_{9 + k}", table=d.reset_index(drop=True), figure=fig,
-            claims=[_singular_claim(lambda_nit, d, sref)],
-            meta=dict(alpha=prm.alpha, h_def=prm.h_def, lambdas=list(prm.lambdas)),
-            notes="h-version p = 1 (FE h^-1 = 4..., BE h^-1 = 8...) and p-version (FE "
-                  "h^-1 = 4, BE h^-1 = 6), errors against DOF. Choices: "
-                  + " ".join(CHOICES)))
-    return out
+
+    return _per_lambda(prm, sg, 9, "Example 2, h- and p-version", "DOF", draw,
+                       lambda lam, d, ref: [_singular_claim(lam, d, ref)],
+                       "h-version p = 1 (FE h^-1 = 4..., BE h^-1 = 8...) and p-version "
+                       "(FE h^-1 = 4, BE h^-1 = 6), errors against DOF.")
 
 
 def run(config: dict, quick: bool = False) -> list[ArtefactResult]:

@@ -52,7 +52,7 @@ from hpfebe.bem.lame import LameBEM
 from hpfebe.contact.friction import solve_friction
 from hpfebe.export import boundary_vtu
 from hpfebe.geometry import common_refinement
-from hpfebe.params import from_config
+from hpfebe.params import FrictionalContactScene, from_config
 from hpfebe.results import ArtefactResult, Claim, beats_uniform_claim, range_claim
 
 ARTEFACTS = ("figure_3_2", "figure_3_3", "figure_3_4", "figure_3_5", "figure_3_6",
@@ -114,11 +114,7 @@ VARIANT_LABEL = {"literal": "adaptive (3.107)", "balanced": "adaptive (3.107) ba
 
 
 @dataclass(frozen=True)
-class Params:
-    E: float = 266926.0
-    nu: float = 0.29
-    plane: str = "strain"
-    mu_f: float = 0.1
+class Params(FrictionalContactScene):
     theta: float = 0.9
     n_initial: int = 4
     n_steps: int = 6

@@ -508,33 +508,34 @@ def conditioning_claims(st_df: pd.DataFrame) -> list[Claim]:
 
 
 def flat_claims(st_df: pd.DataFrame, summ: dict) -> list[Claim]:
-    """Flat obstacle: accurate until cond * macheps ~ 1 (round-off floor)."""
+    """Flat obstacle: accurate while accepted; the breakdown is reported, not hidden."""
     claims = []
     for prob, p, g in _groups(st_df, "flat"):
         v = summ[(prob, p)]
         sat = v["penalty_error_saturates_at"]
-        at = g[g.C_eps == sat].iloc[0] if sat is not None else None
-        c_sat = float(at.condition_number) if at is not None else math.nan
-        cm_sat = float(at.cond_x_macheps) if at is not None else math.nan
+        acc, bad = g[g.accepted], g[~g.accepted]
+        pe = acc.penalty_error.to_numpy()
+        # accepted runs: the penalty error falls with eps until the round-off floor
+        follows = bool(len(pe) >= 2 and np.all(np.diff(pe) <= 0.5 * pe[:-1] + 1e-14))
+        reported = bool(bad.reason.str.contains("ill-conditioned|LAPACK|max_iter").all())
         claims.append(Claim(
-            text=f"(stress test, flat obstacle, p={p}) the penalty solution stays accurate "
-                 "until cond(Newton matrix) * machine eps ~ 1; there the penalty error "
-                 "stops decreasing like eps (round-off floor)",
-            # undecidable if the sweep never reaches the round-off floor
-            holds=(None if sat is None else
-                   bool(v["not_accepted"] == [] and cm_sat > 1e-2)),
+            text=f"(stress test, flat obstacle, p={p}) an answer is accepted only while the "
+                 "contact equation is solved to a backward error <= 1e-6, and there the "
+                 "penalty error decreases with eps; beyond (cond * macheps -> 1) the run is "
+                 "reported as ill-conditioned, never as converged",
+            holds=bool(v["false_convergence"] == [] and follows and reported),
             evidence=("penalty error ||U - U_0||_S/||U_0||_S per C_eps: " + ", ".join(
-                f"{c:g}: {e:.1e}" for c, e in zip(g.C_eps, g.penalty_error)) +
-                f"; it saturates at C_eps = {sat} (min {v['min_penalty_error']:.1e}) "
-                f"where cond = {c_sat:.2e} (cond*macheps = {cm_sat:.2f}); "
-                "LAPACK warns (rcond < macheps) from C_eps = "
-                f"{v['first_lapack_warning']}. Runs not accepted: {v['not_accepted']}. "
-                "Why so late: the ill-conditioning is that of a large rank-deficient "
-                "term (1/eps) M_C on the normal contact dofs; the solution is "
-                "dominated by that block, so the LU error stays ~ macheps relative "
-                "(benign ill-conditioning) instead of cond * macheps. err vs the "
-                "limit 0.154398 saturates much earlier, at the n = 16 discretisation "
-                f"error {g.err.iloc[-1]:.2e} (C_eps <= 1e-9).")))
+                f"{c:g}: {e:.1e}{'' if a else ' (not accepted)'}"
+                for c, e, a in zip(g.C_eps, g.penalty_error, g.accepted)) +
+                f"; it reaches its floor at C_eps = {sat} (min "
+                f"{v['min_penalty_error']:.1e}); LAPACK warns (rcond < macheps) from "
+                f"C_eps = {v['first_lapack_warning']}; not accepted: {v['not_accepted']} ("
+                + "; ".join(f"{c:g}: {r}" for c, r in zip(bad.C_eps, bad.reason)) +
+                "). The displacement stays close to the limit even there (it is fixed by "
+                "the constraint), but the pressure (1/eps) (U_n - g)_+ is a quotient of "
+                "round-off: at C_eps = 1e-20 it is off by a factor ~2 (p = 1, n = 8, "
+                "tests/test_penalty_limits.py). err vs the limit 0.154398 saturates much "
+                f"earlier, at the n = 16 discretisation error {g.err.iloc[-1]:.2e}.")))
     return claims
 
 

@@ -47,7 +47,7 @@ from hpfebe.fem import (cell_diameter, distance_to_set, is_conforming, local_mes
                         refine_labelled, refinement_concentration)
 from hpfebe.fem.elasticity import ElasticBody, rectangle_mesh
 from hpfebe.materials import PLANES
-from hpfebe.params import from_config
+from hpfebe.params import FrictionalContactScene, from_config
 from hpfebe.results import ArtefactResult, Claim, beats_uniform_claim, progress
 
 ARTEFACTS = ("figure_4_13", "figure_4_14", "figure_4_15", "figure_4_16")
@@ -111,11 +111,7 @@ CHOICES = (
 
 
 @dataclass(frozen=True)
-class Params:
-    E: float = 266926.0
-    nu: float = 0.29
-    plane: str = "strain"
-    mu_f: float = 0.1
+class Params(FrictionalContactScene):
     u_master: float = 5.0e-4              # master bottom lifted (0, u_master)
     eps_n_factor: float = 10.0            # 1/eps_n = eps_n_factor E
     eps_t_factor: float = 5.0             # 1/eps_t = eps_t_factor E

@@ -72,6 +72,7 @@ class SolverInfo:
     predictor_used: bool = False
     steps: list = field(default_factory=list)
     counts: dict = field(default_factory=dict)
+    backward_error: float = float("nan")
 
 
 @dataclass
@@ -111,6 +112,27 @@ def _line_search(problem, it: Iterate, dx: np.ndarray, ls: LineSearch):
     return alpha, None
 
 
+# accepted backward error of an iterate Newton cannot improve (six digits in the
+# equation; the stopping tolerance itself is usually far smaller)
+BACKWARD_TOL = 1e-6
+
+
+def _roundoff_verdict(info: SolverInfo, it: Iterate, norm, what: str) -> None:
+    """Newton cannot improve the iterate any more: accept it only if its backward error
+    ||R|| / scale (the relative residual of the equation, scale-free) is below
+    BACKWARD_TOL; otherwise the system is too ill-conditioned for the answer to be
+    trusted."""
+    be = _norm(it.residual, norm) / max(it.scale, np.finfo(float).tiny)
+    info.backward_error = be
+    if be <= BACKWARD_TOL:
+        info.converged = True
+        info.reason = (f"converged ({what}; backward error {be:.1e}, the residual is "
+                       "limited by the conditioning)")
+    else:
+        info.reason = (f"ill-conditioned: {what} with backward error {be:.1e} > "
+                       f"{BACKWARD_TOL:.1e}; the answer cannot be trusted")
+
+
 def newton(problem: NewtonProblem, x0: np.ndarray, tol: float, max_iter: int = 50,
            atol: float = 0.0, norm=np.inf, line_search: LineSearch | None = None,
            predictor: Callable[[Iterate], np.ndarray | None] | None = None,
@@ -120,7 +142,9 @@ def newton(problem: NewtonProblem, x0: np.ndarray, tol: float, max_iter: int = 5
     ``predictor``: an optional first candidate (e.g. a linear "bonded" solution), taken
     when its merit is lower; it counts as an iteration.  ``roundoff_stop``: a Newton
     update at round-off level relative to x ends the iteration as converged (for
-    ill-conditioned systems whose residual floor lies above tol).  Cycling: a contact
+    ill-conditioned systems whose residual floor lies above tol) - as converged only if
+    the backward error ||R|| / scale is below BACKWARD_TOL = 1e-6, else
+    "ill-conditioned".  Cycling: a contact
     pattern (``Iterate.key``) met before without decrease of the merit since then ends
     the iteration ("cycling"), or as converged if the step was at round-off level
     (stagnation).  Divergence: a non-finite residual, or one above ``divergence`` times
@@ -156,10 +180,10 @@ def newton(problem: NewtonProblem, x0: np.ndarray, tol: float, max_iter: int = 5
             return it, info
         xmax = np.abs(it.x).max(initial=0.0)
         if roundoff_stop and np.abs(dx).max(initial=0.0) <= 64 * EPS * xmax:
-            # the k-th Newton system was solved (and counts), its update is not taken
-            info.iterations, info.converged = k, True
-            info.reason = ("converged (Newton update at round-off level; the residual is "
-                           "limited by the conditioning)")
+            # the k-th Newton system was solved (and counts), its update is not taken;
+            # converged only if the backward error of the iterate is small
+            info.iterations = k
+            _roundoff_verdict(info, it, norm, "Newton update at round-off level")
             return it, info
         alpha, new = _line_search(problem, it, dx, ls)
         if new is None:
@@ -180,9 +204,7 @@ def newton(problem: NewtonProblem, x0: np.ndarray, tol: float, max_iter: int = 5
         if it.key is not None:
             if it.key in seen and it.merit >= seen[it.key][1] - 1e-14 * abs(it.merit):
                 if alpha * np.abs(dx).max() <= 1e-8 * np.abs(it.x).max():
-                    info.converged = True
-                    info.reason = ("converged (stagnation at round-off level; the "
-                                   "residual is limited by the conditioning)")
+                    _roundoff_verdict(info, it, norm, "stagnation at round-off level")
                 else:
                     info.reason = (f"cycling: contact state of iterate {seen[it.key][0]} "
                                    f"repeated at {k} without decrease of the merit")

@@ -17,12 +17,32 @@ those (a YAML list; stored as a tuple), ``T | None``, and dict (taken as given).
 from __future__ import annotations
 
 import dataclasses
+from dataclasses import dataclass
 import types
 import typing
 
 
+@dataclass(frozen=True)
+class FrictionalContactScene:
+    """The material and friction data shared by the contact scenes of Chapters 3-4:
+    E = 266926, nu = 0.29 (plane strain, settled in Chapter 3), Coulomb mu_f = 0.1."""
+
+    E: float = 266926.0
+    nu: float = 0.29
+    plane: str = "strain"
+    mu_f: float = 0.1
+
+
 class ConfigError(ValueError):
-    """A config value of the wrong type or an unknown key."""
+    """A config value of the wrong type or an unknown key.
+
+    ``path`` is the dotted config path of the offending key (e.g.
+    ``"ch3_penalty.n_per_side[1]"``), so that the command line can say which config
+    file set it."""
+
+    def __init__(self, message: str, path: str | None = None):
+        super().__init__(message)
+        self.path = path
 
 
 def _check(value, tp, where: str):
@@ -37,34 +57,34 @@ def _check(value, tp, where: str):
             try:
                 return _check(value, a, where)
             except ConfigError as e:
-                errors.append(str(e))
-        raise ConfigError(errors[0])
+                errors.append(e)
+        raise errors[0]
     if origin in (list, tuple):
         if isinstance(value, (str, bytes, dict)) or not isinstance(value, (list, tuple)):
-            raise ConfigError(f"{where} must be a list, got {value!r}")
+            raise ConfigError(f"{where} must be a list, got {value!r}", where)
         elem = args[0] if args else typing.Any
         return tuple(_check(v, elem, f"{where}[{i}]") for i, v in enumerate(value))
     if tp is typing.Any:
         return value
     if tp is bool:
         if not isinstance(value, bool):
-            raise ConfigError(f"{where} must be true or false, got {value!r}")
+            raise ConfigError(f"{where} must be true or false, got {value!r}", where)
         return value
     if tp is int:
         if isinstance(value, bool) or not isinstance(value, int):
-            raise ConfigError(f"{where} must be an integer, got {value!r}")
+            raise ConfigError(f"{where} must be an integer, got {value!r}", where)
         return value
     if tp is float:
         if isinstance(value, bool) or not isinstance(value, (int, float)):
-            raise ConfigError(f"{where} must be a number, got {value!r}")
+            raise ConfigError(f"{where} must be a number, got {value!r}", where)
         return float(value)
     if tp is str:
         if not isinstance(value, str):
-            raise ConfigError(f"{where} must be a string, got {value!r}")
+            raise ConfigError(f"{where} must be a string, got {value!r}", where)
         return value
     if tp is dict or origin is dict:
         if not isinstance(value, dict):
-            raise ConfigError(f"{where} must be a mapping, got {value!r}")
+            raise ConfigError(f"{where} must be a mapping, got {value!r}", where)
         return value
     raise TypeError(f"unsupported parameter type {tp!r} for {where}")
 
@@ -74,12 +94,13 @@ def from_config(cls, section: dict | None, scene: str = "config"):
     defaults); ConfigError names the scene and key of any unknown or mistyped value."""
     section = {} if section is None else section
     if not isinstance(section, dict):
-        raise ConfigError(f"config section {scene!r} must be a mapping, got {section!r}")
+        raise ConfigError(f"config section {scene!r} must be a mapping, got {section!r}",
+                          scene)
     hints = typing.get_type_hints(cls)
     names = {f.name for f in dataclasses.fields(cls) if f.init}
     unknown = sorted(set(section) - names)
     if unknown:
         raise ConfigError(f"config section {scene!r}: unknown key(s) {unknown}; "
-                          f"allowed: {sorted(names)}")
+                          f"allowed: {sorted(names)}", f"{scene}.{unknown[0]}")
     values = {k: _check(v, hints[k], f"{scene}.{k}") for k, v in section.items()}
     return cls(**values)

@@ -49,6 +49,8 @@ def _labels(labels) -> list:
 class _LinearBody:
     """internal_force / commit of a linear body: K u and K, no history."""
 
+    linear = True
+
     def internal_force(self, u):
         return self.K @ u, self.K
 
@@ -107,10 +109,27 @@ class BEBody(_LinearBody):
         self.space = bem.V_space
         self.ndofs = 2 * self.space.ndof
         self.degree = int(self.mesh.degrees.max())
-        self.S = bem.S_hat if S is None else np.asarray(S, dtype=float)
-        if self.S.shape != (self.ndofs, self.ndofs):
-            raise ValueError(f"S must have shape {(self.ndofs, self.ndofs)}, got {self.S.shape}")
-        self.K = sp.csr_matrix(self.S)
+        self._S = None if S is None else np.asarray(S, dtype=float)
+        if self._S is not None and self._S.shape != (self.ndofs, self.ndofs):
+            raise ValueError(f"S must have shape {(self.ndofs, self.ndofs)}, got {self._S.shape}")
+        self._K = None
+
+    @property
+    def S(self) -> np.ndarray:
+        """The dense S_hat (assembled on first use: traces do not need it)."""
+        if self._S is None:
+            self._S = self.body.S_hat
+        return self._S
+
+    @property
+    def K(self) -> sp.csr_matrix:
+        if self._K is None:
+            self._K = sp.csr_matrix(self.S)
+        return self._K
+
+    def internal_force(self, u):
+        """S_hat u and the dense S_hat (dense blocks stay dense)."""
+        return self.S @ u, self.S
 
     def _elements(self, labels) -> np.ndarray:
         labels = _labels(labels)
@@ -219,6 +238,7 @@ class RigidObstacle:
     tangent; each a float or a callable of the points (n, 2).  No dofs."""
 
     kind = "rigid"
+    linear = True
     ndofs = 0
     degree = 0
 
@@ -227,7 +247,7 @@ class RigidObstacle:
         self.K = sp.csr_matrix((0, 0))
 
     def internal_force(self, u):
-        return np.zeros(0), self.K
+        return np.zeros(0), np.zeros((0, 0))
 
     def commit(self, u) -> None:
         pass

@@ -107,5 +107,5 @@ def solve_friction(bem, eps_n: float, eps_t: float, gap, friction: str = "tresca
             raise ValueError(f"load must have {pr.ndofs} entries, got {f.shape}")
     return pr.solve(f, fixed, None, np.arange(1, load_steps + 1) / load_steps, rtol=tol,
                     max_iter=max_iter, line_search=True, norm="max",
-                    merit="energy" if law == "tresca" else "residual", scale="force",
+                    merit="energy" if law == "tresca" else "residual",
                     predictor=predictor, initial=initial)

@@ -92,11 +92,12 @@ import scipy.sparse.linalg as spla
 from ..nonlinear import Iterate, LineSearch, SingularStep, SolverInfo, load_path
 from ..quadrature import gauss_legendre
 from .bodies import as_body, pointwise
+from .positive_part import ExactPositivePart
 from .laws import OPEN, SLIP, STATE_NAMES, STICK, penalty_friction, positive, \
     tresca_energy, updated_slip
 
 MERITS = ("residual", "energy")
-SCALES = ("initial", "force")
+QUADRATURES = ("gauss", "exact")
 
 
 def project_onto_polyline(points: np.ndarray, a: np.ndarray, b: np.ndarray):
@@ -123,6 +124,27 @@ def project_onto_polyline(points: np.ndarray, a: np.ndarray, b: np.ndarray):
     return seg, s[i, seg], excess[i, seg], dist[i, seg]
 
 
+
+
+def _trace_maps(nm, sides, ndofs):
+    """(G_n, G_t, t_m): the sparse maps U -> dg_n, dg_t at the points (one entry per
+    trace basis function, component and side) for the normals n_m, tangents
+    t_m = (n_m,y, -n_m,x); ``sides`` = [(body, ids, s, dof offset, sign)]."""
+    tm = np.column_stack([nm[:, 1], -nm[:, 0]])
+    n = nm.shape[0]
+    rows, cols, vn, vt = [], [], [], []
+    for body, ids, par, off, sign in sides:
+        tc, tv = body.trace(ids, par)
+        for j in range(tv.shape[1]):
+            for c in (0, 1):
+                rows.append(np.arange(n))
+                cols.append(tc[:, c, j] + off)
+                vn.append(sign * tv[:, j] * nm[:, c])
+                vt.append(sign * tv[:, j] * tm[:, c])
+    rows, cols = np.concatenate(rows), np.concatenate(cols)
+    Gn = sp.csr_matrix((np.concatenate(vn), (rows, cols)), shape=(n, ndofs))
+    Gt = sp.csr_matrix((np.concatenate(vt), (rows, cols)), shape=(n, ndofs))
+    return Gn, Gt, tm
 
 
 @dataclass
@@ -221,11 +243,14 @@ class TwoBodyContact:
     nq : Gauss points per integration piece (two bodies: at least p_max + 1 with a BE
         body; rigid master: per element, default p_I + 1 for a BE slave, 2 for FE)
     split : split the slave segments at the projections of the master vertices
+    quadrature : "gauss" (fixed points above) or "exact": a BE body against a rigid
+        obstacle without friction, (U_n - g_h)_+ integrated exactly on the pieces where
+        it is positive (:mod:`hpfebe.contact.positive_part`, Section 3.2)
     """
 
     def __init__(self, slave, master, slave_boundary, master_boundary=None,
                  eps_n: float = None, eps_t: float = 1.0, mu_f: float = 0.0, F=None,
-                 nq: Optional[int] = 2, split: bool = True):
+                 nq: Optional[int] = 2, split: bool = True, quadrature: str = "gauss"):
         self.bodies = {"slave": as_body(slave, "slave"), "master": as_body(master, "master")}
         self.slave, self.master = slave, master
         if self.bodies["slave"].kind == "rigid":
@@ -257,6 +282,19 @@ class TwoBodyContact:
             self.motion = np.zeros(len(self.points))
         self.F = None if F is None else pointwise("F", F, self.points, allow_negative=False)
         self.law_name = "tresca" if F is not None else "coulomb"
+        self.exact = self._exact_quadrature(quadrature, slave_boundary)
+
+    def _exact_quadrature(self, quadrature: str, slave_boundary):
+        if quadrature not in QUADRATURES:
+            raise ValueError(f"quadrature must be one of {QUADRATURES}, got {quadrature!r}")
+        if quadrature == "gauss":
+            return None
+        sb, mb = self.bodies["slave"], self.bodies["master"]
+        if not (sb.kind == "BE" and mb.kind == "rigid" and self.F is None
+                and self.mu_f == 0):
+            raise ValueError("quadrature='exact' is for a BE body against a rigid obstacle "
+                             "without friction")
+        return ExactPositivePart(sb.mesh, sb.space, np.unique(self.point_facets), mb.gap)
 
     # ------------------------------------------------------------------ geometry
     def _build_rigid(self, slave_boundary) -> None:
@@ -289,24 +327,9 @@ class TwoBodyContact:
         self.motion = pointwise("obstacle_slip", obstacle.motion, self.points)
 
     def _set_traces(self, nm, sides) -> None:
-        """Normals n_m, tangents t_m = (n_m,y, -n_m,x) and the sparse maps U -> dg_n,
-        dg_t at the points (one entry per trace basis function, component and side)."""
+        """Normals n_m, tangents t_m and the sparse maps U -> dg_n, dg_t at the points."""
         self.normals = nm
-        self.tangents = tm = np.column_stack([nm[:, 1], -nm[:, 0]])
-        n = nm.shape[0]
-        rows, cols, vn, vt = [], [], [], []
-        for body, ids, par, off, sign in sides:
-            tc, tv = body.trace(ids, par)
-            for j in range(tv.shape[1]):
-                for c in (0, 1):
-                    rows.append(np.arange(n))
-                    cols.append(tc[:, c, j] + off)
-                    vn.append(sign * tv[:, j] * nm[:, c])
-                    vt.append(sign * tv[:, j] * tm[:, c])
-        rows, cols = np.concatenate(rows), np.concatenate(cols)
-        shape = (n, self.ndofs)
-        self.Gn = sp.csr_matrix((np.concatenate(vn), (rows, cols)), shape=shape)
-        self.Gt = sp.csr_matrix((np.concatenate(vt), (rows, cols)), shape=shape)
+        self.Gn, self.Gt, self.tangents = _trace_maps(nm, sides, self.ndofs)
 
     def _build_contact(self, slave_boundary, master_boundary) -> None:
         S, M = self.bodies["slave"], self.bodies["master"]
@@ -410,54 +433,97 @@ class TwoBodyContact:
         return self._contact_body(body).body
 
     # ------------------------------------------------------------------ contact law
-    def contact_state(self, U: np.ndarray, slip: np.ndarray, motion=None) -> dict:
-        """Gap g_n, relative tangential displacement g_t and the law at U."""
-        g_n = self.g0 + self.Gn @ U
-        g_t = self.Gt @ U - (self.motion if motion is None else motion)
+    def _quadrature(self, U: np.ndarray) -> dict:
+        """The contact points at U: fixed (Gauss points of the slave segments), or with
+        ``quadrature="exact"`` the Gauss points of the pieces where U_n - g_h > 0."""
+        if self.exact is None:
+            return dict(Gn=self.Gn, Gt=self.Gt, weights=self.weights, g0=self.g0,
+                        points=self.points, outside=self.outside, elements=self.point_facets)
+        q = self.exact.points(U)
+        S, ids = self.bodies["slave"], q["ids"]
+        nm = -S.mesh.normals[ids]
+        Gn, Gt, _ = _trace_maps(nm, [(S, ids, q["s"], 0, 1.0)], self.ndofs) if ids.size \
+            else (sp.csr_matrix((0, self.ndofs)),) * 2 + (None,)
+        return dict(Gn=Gn, Gt=Gt, weights=q["weights"], g0=q["g0"],
+                    points=S.mesh.points(ids, 2.0 * q["s"] - 1.0) if ids.size
+                    else np.zeros((0, 2)), outside=np.zeros(ids.size, bool), elements=ids,
+                    n_active=q["n_active"])
+
+    def contact_state(self, U: np.ndarray, slip, motion=None) -> dict:
+        """Contact points, gap g_n, relative tangential displacement g_t and the law at U."""
+        cs = self._quadrature(U)
+        g_n = cs["g0"] + cs["Gn"] @ U
+        if self.exact is None:
+            g_t = cs["Gt"] @ U - (self.motion if motion is None else motion)
+        else:
+            g_t, slip = np.zeros_like(g_n), 0.0          # frictionless
         law = penalty_friction(-g_n, g_t, slip, self.eps_n, self.eps_t,
                                mu_f=self.mu_f if self.F is None else None, F=self.F,
-                               active=~self.outside)
-        return dict(g_n=g_n, g_t=g_t, p_n=law.p_n, t_t=law.t_t, state=law.state, law=law)
+                               active=~cs["outside"])
+        cs.update(g_n=g_n, g_t=g_t, p_n=law.p_n, t_t=law.t_t, state=law.state, law=law)
+        return cs
 
     def contact_force(self, cs: dict) -> np.ndarray:
         """f_c(U) = sum_q w_q [-p_n dg_n + t_t dg_t] (the traction on the slave is
         p_n n_m - t_t t_m, on the master its negative)."""
-        w = self.weights
-        return self.Gn.T @ (w * -cs["p_n"]) + self.Gt.T @ (w * cs["t_t"])
+        w = cs["weights"]
+        return cs["Gn"].T @ (w * -cs["p_n"]) + cs["Gt"].T @ (w * cs["t_t"])
 
     def internal_force(self, U: np.ndarray, slip: np.ndarray, motion=None):
-        """K U + f_c(U) and the contact state at U."""
+        """f_int(U) + f_c(U) and the state at U: the bodies' internal forces and tangents
+        (``body.internal_force``: K U and K for a linear body, the return-map force and
+        algorithmic tangent of a plastic one, from its committed history) and the
+        contact state."""
         cs = self.contact_state(U, slip, motion)
-        return self.K @ U + self.contact_force(cs), cs
+        (fs, Ks), (fm, Km) = (self.bodies["slave"].internal_force(U[: self.offset]),
+                              self.bodies["master"].internal_force(U[self.offset:]))
+        cs["f_body"] = np.concatenate([fs, fm])
+        cs["K_body"] = self._blocks(Ks, Km)
+        cs["f_c"] = self.contact_force(cs)
+        return cs["f_body"] + cs["f_c"], cs
 
-    def contact_tangent(self, law) -> sp.csr_matrix:
+    def _blocks(self, Ks, Km):
+        """The block diagonal of the body tangents (4.27)/(4.33): dense without FE body."""
+        if Km.shape[0] == 0:
+            return Ks if self.dense else sp.csr_matrix(Ks)
+        if self.dense:
+            return sla.block_diag(Ks, Km)
+        return sp.block_diag([sp.csr_matrix(Ks), sp.csr_matrix(Km)], format="csr")
+
+    def commit(self, U: np.ndarray) -> None:
+        """Commit the bodies' history (plastic state) at a converged U."""
+        self.bodies["slave"].commit(U[: self.offset])
+        self.bodies["master"].commit(U[self.offset:])
+
+    def contact_tangent(self, cs: dict) -> sp.csr_matrix:
         """Linearised contact terms (Section 4.2.5): Gn^T W_n Gn + Gt^T (W_t Gt - W_tn Gn),
         W = diag(w dp_n), diag(w dt_t), diag(w dt_n)."""
-        w = self.weights
-        C = self.Gn.T @ sp.diags(w * law.dp_n) @ self.Gn
+        w, law, Gn, Gt = cs["weights"], cs["law"], cs["Gn"], cs["Gt"]
+        C = Gn.T @ sp.diags(w * law.dp_n) @ Gn
         if np.any(law.dt_t) or np.any(law.dt_n):
-            C = C + self.Gt.T @ (sp.diags(w * law.dt_t) @ self.Gt
-                                 - sp.diags(w * law.dt_n) @ self.Gn)
+            C = C + Gt.T @ (sp.diags(w * law.dt_t) @ Gt - sp.diags(w * law.dt_n) @ Gn)
         return C
 
     def tangent(self, cs: dict):
         """Consistent Newton matrix K + C for the state ``cs`` (dense without FE body)."""
-        C = self.contact_tangent(cs["law"])
-        return self.K + C.toarray() if self.dense else (self.K + C).tocsr()
+        C = self.contact_tangent(cs)
+        K = cs["K_body"]
+        return K + C.toarray() if self.dense else (K + C).tocsr()
 
     def energy(self, U: np.ndarray, cs: dict, f: np.ndarray) -> float:
         """1/2 U.K U - f.U + contact potential: the merit of the potential laws
-        (frictionless, Tresca), whose gradient is the residual."""
+        (frictionless, Tresca) of linear bodies, whose gradient is the residual."""
         F = 0.0 if self.F is None else self.F
         pot = tresca_energy(cs["law"], self.eps_n, self.eps_t, F)
-        return float(0.5 * U @ (self.K @ U) - f @ U + self.weights @ pot)
+        return float(0.5 * U @ cs["f_body"] - f @ U + cs["weights"] @ pot)
 
     # ------------------------------------------------------------------ Algorithm 4.1
     def solve(self, f_ext=None, fixed_dofs=None, fixed_values=None,
               load_factors: Sequence[float] = (1.0,), rtol: float = 1e-10,
               atol: float = 0.0, max_iter: int = 30, line_search: bool = False,
               min_step: float = 2.0 ** -12, max_cuts: int = 0, norm: str = "l2",
-              merit: str = "residual", scale: str = "initial", predictor: bool = False,
+              merit: str = "residual", predictor: bool = False,
+              roundoff_stop: bool = False,
               initial: ContactResult | None = None) -> ContactResult:
         """Incremental loading with semismooth Newton (Algorithm 4.1,
         :func:`hpfebe.nonlinear.load_path`).
@@ -467,16 +533,19 @@ class TwoBodyContact:
         a callable; None = 0); the obstacle motion is ramped like the load;
         ``load_factors`` increasing; a failed step is halved and retried from the last
         converged state at most ``max_cuts`` times.  Newton stops when
-        ||R_free|| <= atol + rtol * scale, ``norm`` "l2" or "max", ``scale`` "initial"
-        (max(||F_ext||, ||R^(0)||) of the step) or "force" (max of the load, the
-        residual at U = 0 and |K U| of the iterate).  ``line_search``: Armijo on
+        ||R_free|| <= atol + rtol * scale, ``norm`` "l2" or "max", scale = the largest
+        of the load, the body force and the contact force of the iterate (max-norm over
+        the free dofs; not relative to R^(0), which grows like 1/eps and would accept
+        wrong contact sets for stiff penalties);
+        ``roundoff_stop``: a Newton update at round-off level ends the step, converged
+        only if the backward error is small (:func:`hpfebe.nonlinear.newton`).  ``line_search``: Armijo on
         ``merit`` ("residual": ||R||_2, down to ``min_step``; "energy": the potential,
         for frictionless and Tresca contact, 30 halvings); cycling of the contact
         state is then detected.  ``predictor``: start each step from the bonded
         solution (every point in contact and sticking) when it lowers the merit.
         ``initial``: a converged result of this problem to continue from (U, slip,
         load and obstacle motion ramped from its final values)."""
-        steps = _LoadSteps(self, f_ext, fixed_dofs, fixed_values, merit, scale, initial)
+        steps = _LoadSteps(self, f_ext, fixed_dofs, fixed_values, merit, initial)
         lf = np.asarray(load_factors, dtype=float).ravel()
         if lf.size == 0 or not np.all(np.isfinite(lf)):
             raise ValueError(f"load_factors must be a non-empty finite sequence, got {load_factors!r}")
@@ -500,17 +569,18 @@ class TwoBodyContact:
         it, info = load_path(steps, lf, steps.x0, max_cuts=max_cuts, lam0=0.0, tol=tol,
                              atol=atol, max_iter=int(max_iter), line_search=ls,
                              norm=np.inf if norm == "max" else 2,
-                             predictor=steps.bonded_predictor if predictor else None)
+                             predictor=steps.bonded_predictor if predictor else None,
+                             roundoff_stop=roundoff_stop)
         return self._result(it, info, steps)
 
     def _result(self, it: Iterate, info: SolverInfo, steps) -> ContactResult:
         U, cs = it.x, it.data
         return ContactResult(
             U=U.copy(), u_slave=U[: self.offset].copy(), u_master=U[self.offset:].copy(),
-            converged=info.converged, reason=info.reason, info=info, points=self.points,
-            weights=self.weights, g_n=cs["g_n"], g_t=cs["g_t"], p_n=cs["p_n"],
+            converged=info.converged, reason=info.reason, info=info, points=cs["points"],
+            weights=cs["weights"], g_n=cs["g_n"], g_t=cs["g_t"], p_n=cs["p_n"],
             t_t=cs["t_t"], bound=np.asarray(cs["law"].bound, dtype=float),
-            state=cs["state"], slip=steps.slip, elements=self.point_facets,
+            state=cs["state"], slip=steps.slip, elements=cs["elements"],
             load_vector=steps.f, obstacle_motion=steps.w, friction=self.law_name)
 
 
@@ -519,16 +589,17 @@ class _LoadSteps:
     factor (residual R = K U + f_c(U) - F_ext on the free dofs), its start, and the
     commit of the slip after a converged step (:class:`hpfebe.nonlinear.LoadStep`)."""
 
-    def __init__(self, pr: TwoBodyContact, f_ext, fixed_dofs, fixed_values, merit, scale,
-                 initial):
+    def __init__(self, pr: TwoBodyContact, f_ext, fixed_dofs, fixed_values, merit, initial):
         if merit not in MERITS:
             raise ValueError(f"merit must be one of {MERITS}, got {merit!r}")
+        if merit == "energy" and not all(getattr(b, "linear", False)
+                                          for b in pr.bodies.values()):
+            raise ValueError("merit='energy' needs linear bodies (a plastic body has no "
+                             "potential here): use merit='residual'")
         if merit == "energy" and pr.mu_f > 0:
             raise ValueError("merit='energy' needs a potential law (frictionless or "
                              "Tresca); Coulomb friction has none: use merit='residual'")
-        if scale not in SCALES:
-            raise ValueError(f"scale must be one of {SCALES}, got {scale!r}")
-        self.pr, self.merit, self.scale_rule = pr, merit, scale
+        self.pr, self.merit = pr, merit
         N = pr.ndofs
         fixed = np.asarray([] if fixed_dofs is None else fixed_dofs, dtype=np.int64).ravel()
         if fixed.size and (fixed.min() < 0 or fixed.max() >= N):
@@ -586,11 +657,6 @@ class _LoadSteps:
     def problem(self, lam: float):
         self.f, self.g_fixed = self._load(lam)
         self.w = self.w0 + lam * (self.pr.motion - self.w0)
-        self.ref = None
-        if self.scale_rule == "force":
-            r0 = self.pr.internal_force(np.zeros(self.pr.ndofs), self.slip, self.w)[0] - self.f
-            self.ref = max(np.abs(self.f).max(initial=0.0),
-                           np.abs(r0[self.free]).max(initial=0.0), 1e-300)
         return self
 
     def start(self, x: np.ndarray, lam: float) -> np.ndarray:
@@ -599,7 +665,9 @@ class _LoadSteps:
         return x
 
     def commit(self, it: Iterate) -> None:
-        self.slip = updated_slip(it.data["g_t"], it.data["law"], self.pr.eps_t)
+        if self.pr.exact is None:       # (the exact quadrature is frictionless)
+            self.slip = updated_slip(it.data["g_t"], it.data["law"], self.pr.eps_t)
+        self.pr.commit(it.x)
 
     def record(self, it: Iterate, info: SolverInfo) -> None:
         st = it.data["state"]
@@ -610,29 +678,37 @@ class _LoadSteps:
         pr, free = self.pr, self.free
         fint, cs = pr.internal_force(U, self.slip, self.w)
         R = (fint - self.f)[free]
-        if self.scale_rule == "initial":
-            if self.ref is None:
-                self.ref = max(float(np.linalg.norm(self.f[free])), float(np.linalg.norm(R)))
-            scale = self.ref
-        else:
-            scale = max(self.ref, np.abs((pr.K @ U)[free]).max(initial=0.0))
+        scale = max(np.abs(self.f[free]).max(initial=0.0),
+                    np.abs(cs["f_body"][free]).max(initial=0.0),
+                    np.abs(cs["f_c"][free]).max(initial=0.0), 1e-300)
         merit = pr.energy(U, cs, self.f) if self.merit == "energy" \
             else float(np.linalg.norm(R))
-        key = cs["law"].key if self.detect_cycling else None
+        key = None
+        if self.detect_cycling:
+            key = cs["law"].key if pr.exact is None else pr.exact.key(U)
         return Iterate(U, R, merit, scale, key, cs)
 
     def slope(self, it: Iterate, dx: np.ndarray) -> float:
         return float(it.residual @ dx[self.free]) if self.merit == "energy" else -it.merit
 
     def _solve(self, A, r: np.ndarray) -> np.ndarray:
-        free = self.free
-        if self.pr.dense:
+        """The Newton system on the free dofs: LAPACK for a dense system (symmetric
+        solver for the potential laws), a sparse LU with a check of its residual
+        otherwise.  Ill-conditioning is not an error here (LAPACK's LinAlgWarning reaches
+        the caller): the backward error of the result decides convergence."""
+        free, pr = self.free, self.pr
+        if pr.dense:
+            sym = "sym" if (pr.F is not None or pr.mu_f == 0) else "gen"
+            Af = A[np.ix_(free, free)]
             try:
-                with warnings.catch_warnings():
-                    warnings.simplefilter("error", sla.LinAlgWarning)
-                    d = sla.solve(A[np.ix_(free, free)], r)
-            except (np.linalg.LinAlgError, ValueError, sla.LinAlgWarning):
+                d = sla.solve(Af, r, assume_a=sym)
+            except (np.linalg.LinAlgError, ValueError):
                 raise SingularStep("singular Newton matrix (body not fixed?)") from None
+            rel = np.linalg.norm(Af @ d - r) / max(np.linalg.norm(r), 1e-300)
+            if np.all(np.isfinite(d)) and rel > 1e-6:
+                raise SingularStep(f"ill-conditioned Newton matrix: the linear solve has a "
+                                   f"relative residual {rel:.1e} (singular or cond * "
+                                   f"macheps >~ 1)")
         else:
             Af = A[free][:, free].tocsc()
             try:
@@ -646,7 +722,7 @@ class _LoadSteps:
                 d[:] = np.nan
         if not np.all(np.isfinite(d)):
             raise SingularStep("singular Newton matrix (body not fixed?)")
-        dx = np.zeros(self.pr.ndofs)
+        dx = np.zeros(pr.ndofs)
         dx[free] = d
         return dx
 
@@ -658,16 +734,17 @@ class _LoadSteps:
         current slip): the law replaced by the linear springs 1/eps_n, 1/eps_t; None if
         singular."""
         pr, n = self.pr, len(self.slip)
-        w = pr.weights
-        ones = np.ones(n)
         cs = it.data
+        w, Gn, Gt = cs["weights"], cs["Gn"], cs["Gt"]
+        ones = np.ones(n)
         pen = -cs["g_n"]
         rel = cs["g_t"] - self.slip
-        Rb = pr.K @ it.x - self.f + pr.Gn.T @ (w * -pen / pr.eps_n) \
-            + pr.Gt.T @ (w * rel / pr.eps_t)
-        C = pr.Gn.T @ sp.diags(w * ones / pr.eps_n) @ pr.Gn \
-            + pr.Gt.T @ sp.diags(w * ones / pr.eps_t) @ pr.Gt
-        A = pr.K + C.toarray() if pr.dense else (pr.K + C).tocsr()
+        Rb = cs["f_body"] - self.f + Gn.T @ (w * -pen / pr.eps_n) \
+            + Gt.T @ (w * rel / pr.eps_t)
+        C = Gn.T @ sp.diags(w * ones / pr.eps_n) @ Gn \
+            + Gt.T @ sp.diags(w * ones / pr.eps_t) @ Gt
+        K = cs["K_body"]
+        A = K + C.toarray() if pr.dense else (K + C).tocsr()
         try:
             return it.x + self._solve(A, -Rb[self.free])
         except SingularStep:
