@@ -262,6 +262,8 @@ def pointwise(name: str, value, pts: np.ndarray, allow_negative: bool = True) ->
         return np.zeros(len(pts))
     if callable(value):
         v = np.asarray(value(pts), dtype=float).reshape(-1)
+        if v.size == 1:                     # a constant written as a function
+            v = np.full(len(pts), v[0])
         if v.shape != (len(pts),):
             raise ValueError(f"{name}(x) must return one value per point, got {v.shape}")
     else:
@@ -274,6 +276,14 @@ def pointwise(name: str, value, pts: np.ndarray, allow_negative: bool = True) ->
     if not allow_negative and np.any(v < 0):
         raise ValueError(f"{name} must be >= 0 on Gamma_C, got min {v.min()!r}")
     return v
+
+
+def lame_body(bem, name: str = "bem"):
+    """``bem`` checked to be a :class:`LameBEM` (a Laplace operator has scalar traces)."""
+    if not isinstance(bem, LameBEM):
+        raise ValueError(f"{name} must be a LameBEM (2D elasticity), got "
+                         f"{type(bem).__name__}")
+    return bem
 
 
 def as_body(body, name: str = "body"):

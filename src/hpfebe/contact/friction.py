@@ -32,7 +32,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .bodies import BEBody, RigidObstacle
+from .bodies import BEBody, RigidObstacle, lame_body
 from .laws import OPEN, SLIP, STATE_NAMES, STICK, positive  # noqa: F401  (re-exported)
 from .two_body import ContactResult, TwoBodyContact
 
@@ -85,6 +85,7 @@ def solve_friction(bem, eps_n: float, eps_t: float, gap, friction: str = "tresca
     initial : a converged result of the same body, law and points to continue from
         (U, slip, load and obstacle motion ramped from its final values)
     """
+    lame_body(bem)
     eps_n = positive("eps_n", eps_n)
     eps_t = positive("eps_t", eps_t)
     law, bound = _law(friction, F, mu_f)
@@ -105,6 +106,8 @@ def solve_friction(bem, eps_n: float, eps_t: float, gap, friction: str = "tresca
         f = np.asarray(load, dtype=float)
         if f.shape != (pr.ndofs,):
             raise ValueError(f"load must have {pr.ndofs} entries, got {f.shape}")
+        if not np.all(np.isfinite(f)):
+            raise ValueError("load must be finite (NaN or inf entries)")
     return pr.solve(f, fixed, None, np.arange(1, load_steps + 1) / load_steps, rtol=tol,
                     max_iter=max_iter, line_search=True, norm="max",
                     merit="energy" if law == "tresca" else "residual",

@@ -62,7 +62,7 @@ class LawState:
 
 def positive(name: str, value, allow_zero: bool = False) -> float:
     """A finite real > 0 (>= 0 with ``allow_zero``); ValueError naming ``name``."""
-    if isinstance(value, bool):
+    if isinstance(value, (bool, str, bytes)):
         raise ValueError(f"{name} must be a real number, got {value!r}")
     try:
         v = float(value)

@@ -33,7 +33,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..nonlinear import SolverInfo
-from .bodies import BEBody, RigidObstacle
+from .bodies import BEBody, RigidObstacle, lame_body
 from .laws import positive
 from .positive_part import ExactPositivePart
 from .two_body import TwoBodyContact
@@ -90,6 +90,7 @@ def solve_penalty(bem, eps: float, gap, load=None, contact_label: str = "C",
 
     A gap that is never closed gives the zero-contact solution (reason "no contact").
     """
+    lame_body(bem)
     eps = positive("eps (penalty parameter)", eps)
     tol = positive("tol", tol)
     if isinstance(max_iter, bool) or int(max_iter) < 1:
@@ -104,6 +105,8 @@ def solve_penalty(bem, eps: float, gap, load=None, contact_label: str = "C",
         f = np.asarray(load, dtype=float)
         if f.shape != (pr.ndofs,):
             raise ValueError(f"load must have {pr.ndofs} entries, got {f.shape}")
+        if not np.all(np.isfinite(f)):
+            raise ValueError("load must be finite (NaN or inf entries)")
     fixed = body.dofs_on(dirichlet_label) if np.any(bem.mesh.where(dirichlet_label)) \
         else None
     res = pr.solve(f, fixed, rtol=tol, max_iter=max_iter, line_search=True, norm="max",

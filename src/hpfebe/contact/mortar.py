@@ -1,0 +1,556 @@
+"""hp-mortar BEM for two-body contact with friction (Section 4.3.3): the inner
+frictionless contact QP solved by Polyak's projected conjugate gradients, the Uzawa
+algorithm for given (Tresca) friction (Algorithm 4.4) and the Dirichlet-to-Neumann
+algorithm (Algorithm 4.3) with damping omega_D, omega_N.
+
+Discrete setting.  Body i is a :class:`hpfebe.bem.lame.LameBEM` body with unknowns U^i in
+V^i_hp^2 (GLL Lagrange basis, interleaved components) and stiffness S_hat^i; its
+Dirichlet dofs are eliminated and S_hat condensed onto the contact dofs once per mesh
+(:class:`CondensedBody`: one Cholesky factorisation of the rest).  The data transfer is
+the mortar projection of :mod:`hpfebe.coupling.mortar` (displacements Q = pi U^2, (4.87))
+and its adjoint (tractions).
+
+Constraints (Algorithm 4.3, step 4) are imposed at the Gauss-Lobatto points of
+Gamma^1_C, which are the nodes of the GLL basis: in the frame (n_j, t_j) of each contact
+node (n_j the outward normal of body 1 given by the scene, t_j = (-n_y, n_x)) the
+unknowns are x = (U_n, U_t) and the constraint is U_n - Q_n <= g (gap g measured along
+n_j to Gamma^2_C).  The friction functional j(W_t - Q_t) = int F |W_t - Q_t| ds is
+integrated by the Gauss-Lobatto rule of each element (weights w_j, lumped), so that
+the Tresca conditions hold pointwise at these points: |lambda_j| <= 1 and
+lambda_j (U_t - Q_t)_j = |(U_t - Q_t)_j|.
+
+Every outer loop is :func:`hpfebe.nonlinear.fixed_point` (stopping rule
+||x_k - x_{k-1}|| <= TOL ||x_k||, divergence and iteration cap detected there); the inner
+solves report a :class:`~hpfebe.nonlinear.SolverInfo` collected in ``info.steps``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+import scipy.linalg as sla
+
+from ..bem.lame import LameBEM
+from ..coupling.mortar import MortarProjection
+from ..geometry import BoundaryMesh
+from ..nonlinear import SolverInfo, fixed_point
+from ..quadrature import gauss_lobatto
+
+
+# --------------------------------------------------------------------------- Polyak
+def projected_cg(A, b, upper, x0=None, tol: float = 1e-10, max_iter: int | None = None):
+    """Polyak's projected conjugate gradients [53] for the bound-constrained QP
+
+        min 1/2 x^T A x - b^T x   subject to   x <= upper   (A SPD, upper may be +inf).
+
+    CG on the face of the active set; a CG step leaving the feasible set is cut at the
+    first bound hit, that variable joins the active set and CG restarts; when CG has
+    converged on a face, the active variables whose multiplier has the wrong sign
+    (gradient g_i = (A x - b)_i > 0, pulling into the interior) are all released.
+    Converged when the projected gradient (g on the free set, max(g, 0) on the active
+    set) is <= tol * max(||b||, ||A x||) (the KKT conditions).  Returns (x, SolverInfo);
+    ``info.counts`` has the CG steps and the final active set size."""
+    A = np.asarray(A, dtype=float)
+    b = np.asarray(b, dtype=float)
+    u = np.asarray(upper, dtype=float)
+    n = b.size
+    if A.shape != (n, n) or u.shape != (n,):
+        raise ValueError(f"A must be ({n}, {n}) and upper ({n},), got {A.shape}, {u.shape}")
+    if not (np.isfinite(tol) and tol > 0):
+        raise ValueError(f"tol must be positive, got {tol!r}")
+    if np.any(np.isnan(u)):
+        raise ValueError("upper contains NaN")
+    max_iter = 20 * n + 100 if max_iter is None else int(max_iter)
+    x = np.minimum(np.zeros(n) if x0 is None else np.asarray(x0, dtype=float), u)
+    g = A @ x - b
+    info = SolverInfo(False, "max_iter")
+    steps = 0
+
+    def kkt(x, g):
+        at = x >= u
+        pg = np.where(at, np.maximum(g, 0.0), g)
+        return float(np.linalg.norm(pg)), float(tol * max(np.linalg.norm(b),
+                                                           np.linalg.norm(A @ x), 1e-300))
+
+    while steps < max_iter:
+        r, thr = kkt(x, g)
+        info.residuals.append(r)
+        if not np.isfinite(r):
+            info.reason = "diverged: non-finite gradient"
+            break
+        if r <= thr:
+            info.converged, info.reason = True, "converged"
+            break
+        active = (x >= u) & (g <= 0.0)           # held: multiplier -g_i >= 0
+        free = ~active
+        p = np.where(free, -g, 0.0)
+        rr = p @ p
+        while steps < max_iter:
+            steps += 1
+            Ap = A @ p
+            pAp = p @ Ap
+            if pAp <= 0:
+                info.reason = "matrix not positive definite on the free set"
+                info.counts = dict(cg_steps=steps, active=int(np.sum(x >= u)))
+                info.iterations = steps
+                return x, info
+            alpha = rr / pAp
+            up = free & (p > 0)
+            afeas = np.min((u[up] - x[up]) / p[up]) if np.any(up) else np.inf
+            if afeas < alpha:                    # hit a bound: cut, restart CG
+                x = x + afeas * p
+                with np.errstate(invalid="ignore"):
+                    hit = up & (x >= u - 1e-14 * np.maximum(np.abs(u), 1.0))
+                x[hit] = u[hit]
+                g = A @ x - b
+                break
+            x = x + alpha * p
+            g = g + alpha * Ap
+            gf = np.where(free, g, 0.0)
+            if np.linalg.norm(gf) <= kkt(x, g)[1]:
+                g = A @ x - b
+                break
+            rr_new = gf @ gf
+            p = -gf + (rr_new / rr) * p
+            rr = rr_new
+    info.iterations = steps
+    info.counts = dict(cg_steps=steps, active=int(np.sum(x >= u)))
+    return x, info
+
+
+# --------------------------------------------------------------------------- bodies
+class CondensedBody:
+    """S_hat of one body with its Dirichlet dofs eliminated and condensed onto its
+    contact dofs (Schur complement, one Cholesky of the rest):
+
+        A = S_cc - S_cr S_rr^-1 S_rc,   b = f_c - S_cr S_rr^-1 f_r,   f = -S_{.D} U_D.
+
+    ``contact`` are interleaved dofs; those that are Dirichlet dofs are dropped
+    (``cpos`` = positions of the kept ones in ``contact``)."""
+
+    def __init__(self, S, fixed, values, contact):
+        S = np.asarray(S, dtype=float)
+        n = S.shape[0]
+        fixed = np.asarray(fixed, dtype=np.int64)
+        values = np.broadcast_to(np.asarray(values, dtype=float), fixed.shape)
+        contact = np.asarray(contact, dtype=np.int64)
+        is_fixed = np.zeros(n, dtype=bool)
+        is_fixed[fixed] = True
+        self.cpos = np.flatnonzero(~is_fixed[contact])
+        c = contact[self.cpos]
+        rest = np.ones(n, dtype=bool)
+        rest[fixed] = False
+        rest[c] = False
+        r = np.flatnonzero(rest)
+        self.n, self.fixed, self.values, self.c, self.r = n, fixed, values.copy(), c, r
+        self.S = S
+        f = -S[:, fixed] @ self.values
+        cho = sla.cho_factor(S[np.ix_(r, r)])
+        self.X = sla.cho_solve(cho, S[np.ix_(r, c)])
+        self.y = sla.cho_solve(cho, f[r])
+        A = S[np.ix_(c, c)] - S[np.ix_(c, r)] @ self.X
+        self.A = 0.5 * (A + A.T)
+        self.b = f[c] - S[np.ix_(c, r)] @ self.y
+        self._choA = None
+
+    def expand(self, u_c) -> np.ndarray:
+        """The full U from its contact values (Dirichlet values, rest eliminated)."""
+        u = np.zeros(self.n)
+        u[self.fixed] = self.values
+        u[self.c] = u_c
+        u[self.r] = self.y - self.X @ u_c
+        return u
+
+    def solve(self, load_c) -> np.ndarray:
+        """Contact values of the Neumann problem A u_c = b + load_c."""
+        if self._choA is None:
+            self._choA = sla.cho_factor(self.A)
+        return sla.cho_solve(self._choA, self.b + load_c)
+
+    def reaction(self, u_c) -> np.ndarray:
+        """(S U - L) on the contact dofs (the residual functional, Algorithm 4.3 step 5)."""
+        return self.A @ u_c - self.b
+
+
+def ray_gap(points, normals, mesh: BoundaryMesh, label: str) -> np.ndarray:
+    """Distance g_j >= ... from ``points[j]`` along ``normals[j]`` to the elements of
+    ``mesh`` labelled ``label`` (first hit, possibly negative = overlap); +inf where the
+    ray misses them (no constraint there)."""
+    els = np.flatnonzero(mesh.labels == label)
+    a, d = mesh.a[els], mesh.b[els] - mesh.a[els]
+    x, nn = np.asarray(points, float), np.asarray(normals, float)
+    # x + tau n = a + sigma d  ->  [n, -d] (tau, sigma) = a - x
+    det = nn[:, None, 0] * (-d[None, :, 1]) - nn[:, None, 1] * (-d[None, :, 0])
+    rx, ry = a[None, :, 0] - x[:, None, 0], a[None, :, 1] - x[:, None, 1]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        tau = (rx * (-d[None, :, 1]) - ry * (-d[None, :, 0])) / det
+        sig = (nn[:, None, 0] * ry - nn[:, None, 1] * rx) / det
+    ok = (np.abs(det) > 1e-14) & (sig >= -1e-12) & (sig <= 1 + 1e-12)
+    tau = np.where(ok, tau, np.inf)
+    k = np.argmin(np.abs(tau), axis=1)
+    return tau[np.arange(len(x)), k]
+
+
+# --------------------------------------------------------------------------- problem
+@dataclass
+class MortarSolution:
+    """Result of a mortar contact solve: full boundary displacements U1, U2, the
+    friction multiplier lambda and the transferred fields Q (X^1) and P (X^2 dual),
+    the frame quantities at the contact nodes of body 1 and the SolverInfo."""
+
+    U1: np.ndarray
+    U2: np.ndarray
+    lam: np.ndarray
+    Q: np.ndarray
+    P: np.ndarray
+    x: np.ndarray
+    info: SolverInfo
+    extra: dict = field(default_factory=dict)
+
+
+def _check_omega(name, w):
+    if not (np.isfinite(w) and 0.0 < w <= 1.0):
+        raise ValueError(f"{name} must lie in (0, 1], got {w!r}")
+
+
+def _check_pos(name, v):
+    if not (np.isfinite(v) and v > 0.0):
+        raise ValueError(f"{name} must be positive, got {v!r}")
+
+
+class MortarContact:
+    """Two BE bodies in frictional contact through a mortar coupling (Section 4.3.3).
+
+    Parameters
+    ----------
+    bem1, bem2 : LameBEM of body 1 (contact / mortar side) and body 2 (Neumann side)
+    dirichlet1, dirichlet2 : (label, (Ux, Uy)) prescribed displacement on that label
+    F : given friction bound (Tresca), >= 0
+    normal : callable (m, 2) points -> (m, 2) outward unit normals of body 1 on
+        Gamma^1_C (default: the mean of the adjacent element normals)
+    label : contact label of both meshes; axis : pairing parameter of the mortar
+    """
+
+    def __init__(self, bem1: LameBEM, bem2: LameBEM, dirichlet1, dirichlet2, F: float,
+                 normal=None, label: str = "C", axis=(1.0, 0.0)):
+        if not np.isfinite(F) or F < 0:
+            raise ValueError(f"F must be >= 0, got {F!r}")
+        self.bem1, self.bem2, self.F = bem1, bem2, float(F)
+        self.mortar = MortarProjection(bem1.mesh, bem2.mesh, label, label, axis,
+                                       bem1.V_space, bem2.V_space)
+        m = self.mortar
+        self.c1 = np.column_stack([2 * m.dofs1, 2 * m.dofs1 + 1]).ravel()
+        self.c2 = np.column_stack([2 * m.dofs2, 2 * m.dofs2 + 1]).ravel()
+        self.body1 = self._condense(bem1, dirichlet1, self.c1, "dirichlet1")
+        self.body2 = self._condense(bem2, dirichlet2, self.c2, "dirichlet2")
+        if self.body1.cpos.size != self.c1.size:
+            raise ValueError("dirichlet1: the contact nodes of body 1 must not be Dirichlet "
+                             "nodes")
+        nc = m.dofs1.size
+        self.nc = nc
+        self.points = self._node_points(bem1, m.dofs1)
+        nrm = self._default_normals(bem1.mesh, m.dofs1, label) if normal is None else \
+            np.asarray(normal(self.points), dtype=float)
+        if nrm.shape != (nc, 2):
+            raise ValueError(f"normal must return ({nc}, 2) normals, got {nrm.shape}")
+        self.n = nrm / np.linalg.norm(nrm, axis=1)[:, None]
+        self.t = np.column_stack([-self.n[:, 1], self.n[:, 0]])
+        self.gap = ray_gap(self.points, self.n, bem2.mesh, label)
+        self.w = self._lobatto_weights(bem1.mesh, bem1.V_space, m.dofs1, label)
+        # rotation to (U_n, U_t) at the contact nodes: x = R u_c
+        R = np.zeros((2 * nc, 2 * nc))
+        j = np.arange(nc)
+        R[j, 2 * j], R[j, 2 * j + 1] = self.n[:, 0], self.n[:, 1]
+        R[nc + j, 2 * j], R[nc + j, 2 * j + 1] = self.t[:, 0], self.t[:, 1]
+        self.R = R
+        self.A = R @ self.body1.A @ R.T
+        self.A = 0.5 * (self.A + self.A.T)
+        self.b = R @ self.body1.b
+
+    # ---------------------------------------------------------------- set-up helpers
+    @staticmethod
+    def _condense(bem, dirichlet, contact, name):
+        try:
+            label, value = dirichlet
+            value = np.asarray(value, dtype=float).reshape(2)
+        except (TypeError, ValueError):
+            raise ValueError(f"{name} must be (label, (Ux, Uy)), got {dirichlet!r}") from None
+        if not np.any(bem.mesh.labels == label):
+            raise ValueError(f"{name}: no element labelled {label!r}")
+        d = bem.V_space.dofs_on(label)
+        fixed = np.column_stack([2 * d, 2 * d + 1]).ravel()
+        vals = np.tile(value, d.size)
+        return CondensedBody(bem.S_hat, fixed, vals, contact)
+
+    @staticmethod
+    def _node_points(bem, dofs):
+        mesh, sp_ = bem.mesh, bem.V_space
+        xy = np.zeros((sp_.ndof, 2))
+        for p in np.unique(mesh.degrees):
+            els = np.flatnonzero(mesh.degrees == p)
+            xg, _ = gauss_lobatto(int(p) + 1)
+            xy[sp_.elem_dofs[els, :int(p) + 1]] = mesh.points(els[:, None], xg[None, :])
+        return xy[dofs]
+
+    @staticmethod
+    def _default_normals(mesh, dofs, label):
+        sp_ = None
+        from ..spaces import ContinuousSpace
+        sp_ = ContinuousSpace(mesh)
+        acc = np.zeros((sp_.ndof, 2))
+        els = np.flatnonzero(mesh.labels == label)
+        d = sp_.elem_dofs[els]
+        for k in range(d.shape[1]):
+            ok = d[:, k] >= 0
+            np.add.at(acc, d[ok, k], mesh.normals[els[ok]])
+        return acc[dofs]
+
+    @staticmethod
+    def _lobatto_weights(mesh, space, dofs, label):
+        """w_j = int phi_j ds by the Gauss-Lobatto rule of each contact element."""
+        w = np.zeros(space.ndof)
+        els = np.flatnonzero(mesh.labels == label)
+        for p in np.unique(mesh.degrees[els]):
+            e = els[mesh.degrees[els] == p]
+            _, wg = gauss_lobatto(int(p) + 1)
+            d = space.elem_dofs[e, :int(p) + 1]
+            np.add.at(w, d.ravel(), (0.5 * mesh.lengths[e][:, None] * wg[None, :]).ravel())
+        return w[dofs]
+
+    # ---------------------------------------------------------------- Uzawa step
+    @property
+    def rho_crit(self) -> float:
+        """Largest convergent Uzawa step of Theorem 3.1.8 for the linear (all nodes in
+        contact, sticking) model: lambda <- lambda + rho F^2 W^(1/2) C_tt W^(1/2) ...
+        contracts iff rho < 2 / (F^2 lambda_max(W^(1/2) C_tt W^(1/2))), C = A^-1 the
+        condensed compliance at the contact nodes (tangential block), W = diag(w)."""
+        if self.F == 0.0:
+            return np.inf
+        if not hasattr(self, "_rho_crit"):
+            C = np.linalg.inv(self.A)[self.nc:, self.nc:]
+            sw = np.sqrt(self.w)
+            T = sw[:, None] * C * sw[None, :]
+            self._rho_crit = 2.0 / (self.F ** 2 * np.linalg.eigvalsh(0.5 * (T + T.T))[-1])
+        return float(self._rho_crit)
+
+    def rho_step(self, rho: float, relative: bool) -> float:
+        """The Uzawa step used: ``rho`` itself, or rho * rho_crit / 2 when ``relative``
+        (rho = 1 is then the step with the fastest contraction of the stiffest mode)."""
+        _check_pos("rho", rho)
+        if not relative or self.F == 0.0:
+            return float(rho)
+        return float(rho) * 0.5 * self.rho_crit
+
+    # ---------------------------------------------------------------- inner solvers
+    def frame(self, v) -> tuple[np.ndarray, np.ndarray]:
+        """Normal and tangential components at the contact nodes of an interleaved
+        vector on the contact dofs of body 1."""
+        v = np.asarray(v).reshape(self.nc, 2)
+        return np.sum(v * self.n, axis=1), np.sum(v * self.t, axis=1)
+
+    def contact_qp(self, Q, lam, x0=None, tol: float = 1e-11):
+        """Algorithm 4.4 step 2: frictionless contact of body 1 against the obstacle Q
+        with the friction load F w lambda, by projected CG.  Returns (x, info)."""
+        Qn, _ = self.frame(Q)
+        rhs = self.b.copy()
+        rhs[self.nc:] -= self.F * self.w * lam
+        upper = np.concatenate([self.gap + Qn, np.full(self.nc, np.inf)])
+        return projected_cg(self.A, rhs, upper, x0=x0, tol=tol)
+
+    def uzawa(self, Q, rho: float = 1.0, tol: float = 1e-6, max_iter: int = 2000,
+              lam0=None, x0=None, cg_tol: float = 1e-11):
+        """Algorithm 4.4 (Uzawa for given friction) against the obstacle Q:
+        lambda_{m+1} = P_Lambda(lambda_m + rho F (U_t - Q_t)), stop when
+        ||lambda_m - lambda_{m-1}|| <= TOL_U ||lambda_m||.  Returns (x, lambda, info);
+        x = (U_n, U_t) at the contact nodes for the returned lambda."""
+        _check_pos("rho", rho)
+        _, Qt = self.frame(Q)
+        lam0 = np.zeros(self.nc) if lam0 is None else np.asarray(lam0, dtype=float)
+        state = {"x": x0}
+
+        def update(lam):
+            x, info = self.contact_qp(Q, lam, state["x"], cg_tol)
+            state["x"] = x
+            return np.clip(lam + rho * self.F * (x[self.nc:] - Qt), -1.0, 1.0), info
+
+        lam, info = fixed_point(update, lam0, tol, max_iter, norm=2)
+        x, qinfo = self.contact_qp(Q, lam, state["x"], cg_tol)
+        if not qinfo.converged and info.converged:
+            info.converged, info.reason = False, f"final QP: {qinfo.reason}"
+        return x, lam, info
+
+    # ---------------------------------------------------------------- DtN
+    def dtn(self, omega_D: float, omega_N: float, rho: float = 1.0, tol: float = 1e-6,
+            tol_U: float = 1e-6, max_iter: int = 200, max_uzawa: int = 2000,
+            divergence: float = 1e6, rho_relative: bool = True) -> MortarSolution:
+        """Algorithm 4.3 (Dirichlet-to-Neumann) with damping omega_D, omega_N in (0, 1]:
+
+        2. S2 U2 = L2 - P_k (Neumann problem of body 2; P_k = the transferred contact
+           force on body 1, so body 2 carries -P_k),
+        3. Q_k = (1 - omega_D) Q_{k-1} + omega_D D^-1 B U2,
+        4. contact problem of body 1 against Q_k (Uzawa, Algorithm 4.4),
+        5. R1 = S1 U1 - L1 on the contact dofs (the contact force on body 1),
+        6. P_{k+1} = (1 - omega_N) P_k + omega_N B^T D^-T R1,
+        7. stop if ||P_{k+1} - P_k|| <= TOL ||P_{k+1}|| (:func:`fixed_point`).
+
+        The Uzawa multiplier and the QP solution are warm-started from the previous DtN
+        iteration.  Non-convergence (cap, growth, NaN) is reported in ``info.reason``.
+        ``rho_relative``: the Uzawa step is rho * rho_crit / 2 (:meth:`rho_step`)."""
+        _check_omega("omega_D", omega_D)
+        _check_omega("omega_N", omega_N)
+        rho = self.rho_step(rho, rho_relative)
+        m, b2 = self.mortar, self.body2
+        st = dict(Q=np.zeros(2 * self.nc), lam=np.zeros(self.nc), x=None)
+
+        def neumann(P):
+            u2c = b2.solve(-P[b2.cpos])
+            return u2c, b2.expand(u2c)[self.c2]
+
+        def update(P):
+            _, u2 = neumann(P)
+            Q = (1.0 - omega_D) * st["Q"] + omega_D * m.project(u2)
+            x, lam, info = self.uzawa(Q, rho, tol_U, max_uzawa, st["lam"], st["x"])
+            st.update(Q=Q, lam=lam, x=x)
+            R1 = self.body1.reaction(self.R.T @ x)
+            return (1.0 - omega_N) * P + omega_N * m.adjoint(R1), info
+
+        P, info = fixed_point(update, np.zeros(self.c2.size), tol, max_iter, norm=2,
+                              divergence=divergence)
+        u2c, _ = neumann(P)
+        x = st["x"] if st["x"] is not None else np.zeros(2 * self.nc)
+        U1 = self.body1.expand(self.R.T @ x)
+        U2 = b2.expand(u2c)
+        return MortarSolution(U1, U2, st["lam"], st["Q"], P, x, info)
+
+    # ---------------------------------------------------------------- global Uzawa
+    def _global_operators(self):
+        """Dense pieces of Algorithm 4.5 on the contact dofs (built once): the lumped
+        Gauss-Lobatto pairing Wk = diag(w) x I2 on Gamma^1_C, the traction transfer
+        T2 = (B^T D^-T)(free rows of body 2) and H = A1^-1 + Pi A2^-1 Pi^T with
+        Pi = D^-1 B (restricted to body 2's free contact dofs): the response of the
+        relative displacement U1 - Pi U2 to the nodal traction P is -H Wk P."""
+        if not hasattr(self, "_glob"):
+            m, nc = self.mortar, self.nc
+            Wk = np.repeat(self.w, 2)
+            n2 = self.c2.size
+            Pi = np.column_stack([m.project(e) for e in np.eye(n2)])[:, self.body2.cpos]
+            T2 = Pi.T                                   # B^T D^-T restricted, = Pi^T
+            H = np.linalg.inv(self.body1.A) + Pi @ np.linalg.solve(self.body2.A, Pi.T)
+            sw = np.sqrt(Wk)
+            G = sw[:, None] * H * sw[None, :]
+            lam_max = np.linalg.eigvalsh(0.5 * (G + G.T))[-1]
+            self._glob = dict(Wk=Wk, T2=T2, rho_crit=2.0 / lam_max, nc=nc)
+        return self._glob
+
+    def global_uzawa(self, rho: float = 1.0, tol: float = 1e-6, max_iter: int = 20000,
+                     friction: str = "coulomb", mu_f: float = 0.1, rho_relative: bool = True,
+                     divergence: float = 1e6) -> MortarSolution:
+        """Algorithm 4.5 (Uzawa for the global problem): with the nodal contact traction
+        P at the Gauss-Lobatto points of Gamma^1_C (force on body 1 = -P),
+
+        2. S1 U1 = L1 - <P, .>_1 and S2 U2 = L2 + pi*<P, .>_1 (two Neumann problems),
+        3. P <- Pi_M(P + rho (U1 - pi U2 - g n)) pointwise in the frame (n, t):
+           P_n <- max(0, P_n + rho d_n), P_t <- clip(P_t + rho d_t, -b, b) with
+           b = mu_f P_n (Coulomb) or b = F (Tresca, ``friction="tresca"``).
+
+        <P, .>_1 is the Gauss-Lobatto (lumped) pairing on Gamma^1_C, the same as the
+        friction functional of :meth:`contact_qp`, so that with Tresca friction this is
+        the discrete problem DtN solves.  Step: rho * rho_crit / 2 if ``rho_relative``
+        (rho_crit = 2 / lambda_max of the linear response, Theorem 3.1.8).  Stopping:
+        :func:`fixed_point` (relative increment of P, at least 3 iterations)."""
+        if friction not in ("coulomb", "tresca"):
+            raise ValueError(f"friction must be 'coulomb' or 'tresca', got {friction!r}")
+        if not (np.isfinite(mu_f) and mu_f >= 0):
+            raise ValueError(f"mu_f must be >= 0, got {mu_f!r}")
+        _check_pos("rho", rho)
+        g = self._global_operators()
+        step = rho * 0.5 * g["rho_crit"] if rho_relative else float(rho)
+        b1, b2, nc = self.body1, self.body2, self.nc
+        gap = np.where(np.isfinite(self.gap), self.gap, 0.0)
+        closed = np.isfinite(self.gap)
+
+        def bodies(p):
+            u1 = b1.solve(-g["Wk"] * p)
+            u2c = b2.solve(g["T2"] @ (g["Wk"] * p))
+            return u1, u2c
+
+        def update(p):
+            u1, u2c = bodies(p)
+            d = u1 - self.mortar.project(b2.expand(u2c)[self.c2])
+            dn, dt = self.frame(d)
+            pn, pt = self.frame(p)
+            pn = np.where(closed, np.maximum(0.0, pn + step * (dn - gap)), 0.0)
+            bound = mu_f * pn if friction == "coulomb" else np.full(nc, self.F)
+            pt = np.clip(pt + step * dt, -bound, bound)
+            return (pn[:, None] * self.n + pt[:, None] * self.t).ravel()
+
+        P, info = fixed_point(update, np.zeros(2 * nc), tol, max_iter, norm=2,
+                              divergence=divergence, min_iter=3)
+        u1, u2c = bodies(P)
+        Q = self.mortar.project(b2.expand(u2c)[self.c2])
+        pn, pt = self.frame(P)
+        bound = mu_f * pn if friction == "coulomb" else np.full(nc, self.F)
+        lam = np.divide(pt, bound, out=np.zeros(nc), where=bound > 0)
+        info.counts = dict(rho=step, rho_crit=g["rho_crit"])
+        return MortarSolution(b1.expand(u1), b2.expand(u2c), lam, Q, P,
+                              self.R @ u1, info, extra=dict(pn=pn, pt=pt))
+
+    # ---------------------------------------------------------------- post-processing
+    def norm_W(self, U1, U2) -> float:
+        """||U||_W = (<W U1, U1> + <W U2, U2>)^(1/2) (Section 4.3.4)."""
+        return float(np.sqrt(U1 @ (self.bem1.W @ U1) + U2 @ (self.bem2.W @ U2)))
+
+    def tresca_residual(self, sol: MortarSolution) -> dict:
+        """Tresca conditions at the Gauss-Lobatto points: max |lambda| - 1, the largest
+        slip where |lambda| < 1 (must vanish) and the largest violation of
+        lambda s = |s| (scaled by max |s|)."""
+        _, Qt = self.frame(sol.Q)
+        s = sol.x[self.nc:] - Qt
+        inner = np.abs(sol.lam) < 1.0 - 1e-9
+        sc = max(np.abs(s).max(), 1e-300)
+        return dict(lam_excess=float(np.abs(sol.lam).max() - 1.0),
+                    stick_slip=float(np.abs(s[inner]).max() if inner.any() else 0.0),
+                    complementarity=float(np.abs(sol.lam * s - np.abs(s)).max() / sc),
+                    slip_scale=float(sc))
+
+
+# --------------------------------------------------------------------------- scene
+def model_problem(n1: int = 16, n2: int = 12, p1: int = 2, p2: int = 2,
+                  E: float = 266926.0, nu: float = 0.29, F: float = 0.1,
+                  u_top=(0.0, -0.09), radius: float = 5.05, plane: str = "strain",
+                  L: float = 2.0) -> MortarContact:
+    """The model problem of Section 4.3.4 (thesis lines 19474-19530): body 1 bounded by
+    Gamma^1_D = [-1,1] x {2} (U = u_top), Gamma^1_N = {-1,1} x [0.1, 2] and the arc
+    Gamma^1_C of radius ``radius`` through (-1, 0.1), (0, 0), (1, 0.1); body 2 =
+    [-1,1] x [-2,0] with Gamma^2_C = [-1,1] x {0} and Gamma^2_D = the rest (U = 0).
+    Meshes: ``n1`` elements on Gamma^1_C (h1 = L / n1, equal angles), ``n2`` on
+    Gamma^2_C (h2 = L / n2), the other sides with ceil(length / h) elements; degrees
+    p1, p2 everywhere.  Normals of Gamma^1_C: the radial direction of the circle; gap
+    along it."""
+    for name, v in (("n1", n1), ("n2", n2), ("p1", p1), ("p2", p2)):
+        if int(v) != v or v < 1:
+            raise ValueError(f"{name} must be a positive integer, got {v!r}")
+    if radius <= 1.0:
+        raise ValueError(f"radius must exceed 1, got {radius!r}")
+    yc = radius                                       # centre (0, R): arc through (0, 0)
+    half = np.arcsin(1.0 / radius)
+    ang = np.linspace(-half, half, int(n1) + 1)
+    arc = np.column_stack([radius * np.sin(ang), yc - radius * np.cos(ang)])
+    h1, h2 = L / n1, L / n2
+    top = float(arc[0, 1])
+    nside = int(np.ceil((2.0 - top) / h1 - 1e-9))
+    verts = np.vstack([arc, [[1.0, 2.0], [-1.0, 2.0]]])
+    n_sides = [1] * int(n1) + [nside, int(np.ceil(2.0 / h1 - 1e-9)), nside]
+    labels = ["C"] * int(n1) + ["N", "D", "N"]
+    mesh1 = BoundaryMesh.polygon(verts, n=n_sides, labels=labels, p=int(p1))
+    k2 = int(np.ceil(2.0 / h2 - 1e-9))
+    mesh2 = BoundaryMesh.polygon([(-1, -2), (1, -2), (1, 0), (-1, 0)], n=[k2, k2, int(n2), k2],
+                                 labels=["D", "D", "C", "D"], p=int(p2))
+    bem1, bem2 = LameBEM(mesh1, E, nu, plane), LameBEM(mesh2, E, nu, plane)
+
+    def normal(x):
+        d = x - np.array([0.0, yc])
+        return d / np.linalg.norm(d, axis=1)[:, None]
+
+    return MortarContact(bem1, bem2, ("D", u_top), ("D", (0.0, 0.0)), F, normal=normal)
