@@ -17,3 +17,13 @@ def test_readme_core_example_runs(capsys):
     assert "S_hat 1 = 0: True" in out
     vals = re.search(r"u\(0.5, 0.5\): (\S+) exact: (\S+)", out)
     assert abs(float(vals.group(1)) - float(vals.group(2))) < 1e-6
+
+
+def test_readme_contact_example_runs(capsys):
+    section = README.read_text().split("## Using the core", 1)[1]
+    code = re.findall(r"```python\n(.*?)```", section, re.S)[1]
+    exec(compile(code, "README.md", "exec"), {})
+    out = capsys.readouterr().out
+    assert out.startswith("True converged")
+    force = float(re.search(r"contact force: (\S+)", out).group(1))
+    assert force > 0   # measured 165.5 (N per unit depth) for the 1e-3 lift
