@@ -33,7 +33,8 @@ from __future__ import annotations
 import numpy as np
 
 from .bodies import BEBody, RigidObstacle, lame_body
-from .laws import OPEN, SLIP, STATE_NAMES, STICK, positive  # noqa: F401  (re-exported)
+from .laws import OPEN, SLIP, STATE_NAMES, STICK  # noqa: F401  (re-exported)
+from .laws import positive
 from .two_body import ContactResult, TwoBodyContact
 
 LAWS = ("tresca", "coulomb")

@@ -80,23 +80,21 @@ solved by LAPACK, sparse ones by a sparse LU with a check of its residual.
 
 from __future__ import annotations
 
-import warnings
-from dataclasses import dataclass, field
-from typing import Callable, Optional, Sequence, Union
+from dataclasses import dataclass
+from typing import Optional, Sequence
 
 import numpy as np
 import scipy.linalg as sla
 import scipy.sparse as sp
-import scipy.sparse.linalg as spla
 
-from ..nonlinear import Iterate, LineSearch, SingularStep, SolverInfo, load_path
+from ..nonlinear import Iterate, LineSearch, SolverInfo, load_path
 from ..quadrature import gauss_legendre
 from .bodies import as_body, pointwise
+from .laws import OPEN, SLIP, STATE_NAMES, STICK  # noqa: F401  (re-exported)
+from .laws import penalty_friction, positive, tresca_energy
+from .loading import LoadSteps
 from .positive_part import ExactPositivePart
-from .laws import OPEN, SLIP, STATE_NAMES, STICK, penalty_friction, positive, \
-    tresca_energy, updated_slip
 
-MERITS = ("residual", "energy")
 QUADRATURES = ("gauss", "exact")
 
 
@@ -545,7 +543,7 @@ class TwoBodyContact:
         solution (every point in contact and sticking) when it lowers the merit.
         ``initial``: a converged result of this problem to continue from (U, slip,
         load and obstacle motion ramped from its final values)."""
-        steps = _LoadSteps(self, f_ext, fixed_dofs, fixed_values, merit, initial)
+        steps = LoadSteps(self, f_ext, fixed_dofs, fixed_values, merit, initial)
         lf = np.asarray(load_factors, dtype=float).ravel()
         if lf.size == 0 or not np.all(np.isfinite(lf)):
             raise ValueError(f"load_factors must be a non-empty finite sequence, got {load_factors!r}")
@@ -582,170 +580,3 @@ class TwoBodyContact:
             t_t=cs["t_t"], bound=np.asarray(cs["law"].bound, dtype=float),
             state=cs["state"], slip=steps.slip, elements=cs["elements"],
             load_vector=steps.f, obstacle_motion=steps.w, friction=self.law_name)
-
-
-class _LoadSteps:
-    """The load steps of :meth:`TwoBodyContact.solve`: the Newton problem at a load
-    factor (residual R = K U + f_c(U) - F_ext on the free dofs), its start, and the
-    commit of the slip after a converged step (:class:`hpfebe.nonlinear.LoadStep`)."""
-
-    def __init__(self, pr: TwoBodyContact, f_ext, fixed_dofs, fixed_values, merit, initial):
-        if merit not in MERITS:
-            raise ValueError(f"merit must be one of {MERITS}, got {merit!r}")
-        if merit == "energy" and not all(getattr(b, "linear", False)
-                                          for b in pr.bodies.values()):
-            raise ValueError("merit='energy' needs linear bodies (a plastic body has no "
-                             "potential here): use merit='residual'")
-        if merit == "energy" and pr.mu_f > 0:
-            raise ValueError("merit='energy' needs a potential law (frictionless or "
-                             "Tresca); Coulomb friction has none: use merit='residual'")
-        self.pr, self.merit = pr, merit
-        N = pr.ndofs
-        fixed = np.asarray([] if fixed_dofs is None else fixed_dofs, dtype=np.int64).ravel()
-        if fixed.size and (fixed.min() < 0 or fixed.max() >= N):
-            raise ValueError(f"fixed_dofs must lie in [0, {N}), got range [{fixed.min()}, {fixed.max()}]")
-        if np.unique(fixed).size != fixed.size:
-            raise ValueError("fixed_dofs must not contain duplicates")
-        self.fixed, self.free = fixed, np.setdiff1d(np.arange(N), fixed)
-        self.f_ext, self.fixed_values = f_ext, fixed_values
-        self.x0, self.slip = np.zeros(N), np.zeros(pr.points.shape[0])
-        self.f0, self.w0 = np.zeros(N), np.zeros_like(self.slip)
-        if initial is not None:
-            self._continue_from(initial)
-        self.f, self.w = self.f0, self.w0
-        self.detect_cycling = False
-
-    def _continue_from(self, initial: ContactResult) -> None:
-        pr = self.pr
-        if not isinstance(initial, ContactResult) or initial.U.shape != (pr.ndofs,) or \
-                initial.points.shape != pr.points.shape or \
-                not np.allclose(initial.points, pr.points) or initial.friction != pr.law_name:
-            raise ValueError("initial must be a result of the same bodies, contact points "
-                             "and friction law")
-        if not initial.converged:
-            raise ValueError(f"initial did not converge ({initial.reason}); not a state "
-                             "to continue from")
-        self.x0, self.slip = initial.U.copy(), initial.slip.copy()
-        self.f0, self.w0 = initial.load_vector.copy(), initial.obstacle_motion.copy()
-
-    def _load(self, lam: float):
-        N, fixed = self.pr.ndofs, self.fixed
-        if self.f_ext is None:
-            f = np.zeros(N)
-        elif callable(self.f_ext):
-            f = np.asarray(self.f_ext(lam), dtype=float)
-        else:
-            f = np.asarray(self.f_ext, dtype=float)
-            if f.shape == (N,):
-                f = self.f0 + lam * (f - self.f0)
-        if f.shape != (N,):
-            raise ValueError(f"f_ext must have shape ({N},), got {f.shape}")
-        if not np.all(np.isfinite(f)):
-            raise ValueError("f_ext must be finite")
-        v = self.fixed_values
-        if v is None:
-            g = np.zeros(fixed.size)
-        elif callable(v):
-            g = np.asarray(v(lam), dtype=float) * np.ones(fixed.size)
-        else:
-            g = lam * np.asarray(v, dtype=float) * np.ones(fixed.size)
-        if g.shape != (fixed.size,):
-            raise ValueError(f"fixed_values must have shape ({fixed.size},), got {g.shape}")
-        return f, g
-
-    # LoadStep protocol
-    def problem(self, lam: float):
-        self.f, self.g_fixed = self._load(lam)
-        self.w = self.w0 + lam * (self.pr.motion - self.w0)
-        return self
-
-    def start(self, x: np.ndarray, lam: float) -> np.ndarray:
-        x = x.copy()
-        x[self.fixed] = self.g_fixed
-        return x
-
-    def commit(self, it: Iterate) -> None:
-        if self.pr.exact is None:       # (the exact quadrature is frictionless)
-            self.slip = updated_slip(it.data["g_t"], it.data["law"], self.pr.eps_t)
-        self.pr.commit(it.x)
-
-    def record(self, it: Iterate, info: SolverInfo) -> None:
-        st = it.data["state"]
-        info.counts = {name: int(np.sum(st == code)) for code, name in STATE_NAMES.items()}
-
-    # NewtonProblem protocol
-    def evaluate(self, U: np.ndarray) -> Iterate:
-        pr, free = self.pr, self.free
-        fint, cs = pr.internal_force(U, self.slip, self.w)
-        R = (fint - self.f)[free]
-        scale = max(np.abs(self.f[free]).max(initial=0.0),
-                    np.abs(cs["f_body"][free]).max(initial=0.0),
-                    np.abs(cs["f_c"][free]).max(initial=0.0), 1e-300)
-        merit = pr.energy(U, cs, self.f) if self.merit == "energy" \
-            else float(np.linalg.norm(R))
-        key = None
-        if self.detect_cycling:
-            key = cs["law"].key if pr.exact is None else pr.exact.key(U)
-        return Iterate(U, R, merit, scale, key, cs)
-
-    def slope(self, it: Iterate, dx: np.ndarray) -> float:
-        return float(it.residual @ dx[self.free]) if self.merit == "energy" else -it.merit
-
-    def _solve(self, A, r: np.ndarray) -> np.ndarray:
-        """The Newton system on the free dofs: LAPACK for a dense system (symmetric
-        solver for the potential laws), a sparse LU with a check of its residual
-        otherwise.  Ill-conditioning is not an error here (LAPACK's LinAlgWarning reaches
-        the caller): the backward error of the result decides convergence."""
-        free, pr = self.free, self.pr
-        if pr.dense:
-            sym = "sym" if (pr.F is not None or pr.mu_f == 0) else "gen"
-            Af = A[np.ix_(free, free)]
-            try:
-                d = sla.solve(Af, r, assume_a=sym)
-            except (np.linalg.LinAlgError, ValueError):
-                raise SingularStep("singular Newton matrix (body not fixed?)") from None
-            rel = np.linalg.norm(Af @ d - r) / max(np.linalg.norm(r), 1e-300)
-            if np.all(np.isfinite(d)) and rel > 1e-6:
-                raise SingularStep(f"ill-conditioned Newton matrix: the linear solve has a "
-                                   f"relative residual {rel:.1e} (singular or cond * "
-                                   f"macheps >~ 1)")
-        else:
-            Af = A[free][:, free].tocsc()
-            try:
-                with warnings.catch_warnings():
-                    warnings.simplefilter("ignore", spla.MatrixRankWarning)
-                    d = spla.splu(Af).solve(r)
-            except RuntimeError:
-                d = np.full(free.size, np.nan)
-            if np.all(np.isfinite(d)) and \
-                    np.linalg.norm(Af @ d - r) > 1e-6 * np.linalg.norm(r):
-                d[:] = np.nan
-        if not np.all(np.isfinite(d)):
-            raise SingularStep("singular Newton matrix (body not fixed?)")
-        dx = np.zeros(pr.ndofs)
-        dx[free] = d
-        return dx
-
-    def step(self, it: Iterate) -> np.ndarray:
-        return self._solve(self.pr.tangent(it.data), -it.residual)
-
-    def bonded_predictor(self, it: Iterate):
-        """The bonded solution (every point in contact and sticking, relative to the
-        current slip): the law replaced by the linear springs 1/eps_n, 1/eps_t; None if
-        singular."""
-        pr, n = self.pr, len(self.slip)
-        cs = it.data
-        w, Gn, Gt = cs["weights"], cs["Gn"], cs["Gt"]
-        ones = np.ones(n)
-        pen = -cs["g_n"]
-        rel = cs["g_t"] - self.slip
-        Rb = cs["f_body"] - self.f + Gn.T @ (w * -pen / pr.eps_n) \
-            + Gt.T @ (w * rel / pr.eps_t)
-        C = Gn.T @ sp.diags(w * ones / pr.eps_n) @ Gn \
-            + Gt.T @ sp.diags(w * ones / pr.eps_t) @ Gt
-        K = cs["K_body"]
-        A = K + C.toarray() if pr.dense else (K + C).tocsr()
-        try:
-            return it.x + self._solve(A, -Rb[self.free])
-        except SingularStep:
-            return None
