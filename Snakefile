@@ -10,6 +10,7 @@
 # artefacts of its module to results/.  A change of the module file or of a config file
 # reruns it.  `rule report` builds report/index.html and report/report.md.
 
+import os
 import shlex
 import sys
 from pathlib import Path
@@ -22,7 +23,9 @@ from experiments.registry import discover  # noqa: E402  (standard library only)
 REGISTRY = discover(Path(workflow.basedir) / "experiments")
 RESULTS = "results"
 LOGS = f"{RESULTS}/logs"
-QUICK = bool(config.get("quick", False))
+QUICK = config.get("quick", False)
+if not isinstance(QUICK, bool):  # "false" is a non-empty string, not false
+    raise ValueError(f"config key 'quick' must be true or false, got {QUICK!r}")
 
 # The config files in the order Snakemake merged them: config/config.yaml, then every
 # --configfile given on the command line.  The CLI merges them the same way.
@@ -41,6 +44,13 @@ for _f in workflow.config_settings.configfiles:
 THREAD_ENV = " ".join(f"{v}={{threads}}" for v in (
     "NUMBA_NUM_THREADS", "OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"))
 PYTHON = shlex.quote(sys.executable)
+
+# Interrupted runs: every job watches the Snakemake process that started it (this one:
+# the Snakefile is read by it) and stops when it is gone, even after a SIGKILL, instead
+# of running on as an orphan that writes into results/; SIGTERM/SIGINT/SIGHUP to a job
+# remove its temporary files (hpfebe.cli.install_signal_handlers).  After an interrupted
+# run: `snakemake --unlock`, then rerun (see README, "Reliability").
+WATCH_ENV = f"HPFEBE_PARENT_PID={os.getpid()}"
 
 
 def artefact_outputs(artefacts):
@@ -80,7 +90,7 @@ for _exp in REGISTRY:
             flags=" ".join((["--quick"] if QUICK else [])
                            + [f"--config {shlex.quote(f)}" for f in CONFIG_FILES]),
         shell:
-            f"{THREAD_ENV} {PYTHON} -m hpfebe run {{params.artefact}} --out {RESULTS} "
+            f"{WATCH_ENV} {THREAD_ENV} {PYTHON} -m hpfebe run {{params.artefact}} --out {RESULTS} "
             "{params.flags} 2> {log}"
 
 
@@ -95,4 +105,4 @@ rule report:
     log:
         f"{LOGS}/report.log",
     shell:
-        f"{PYTHON} -m hpfebe report --results {RESULTS} --out report 2> {{log}}"
+        f"{WATCH_ENV} {PYTHON} -m hpfebe report --results {RESULTS} --out report 2> {{log}}"

@@ -82,10 +82,10 @@ def test_colorbars_decide_d(quick_run):
     ("n_steps: 0", "n_steps"),
     ("n_stepz: 3", "unknown key"),
 ])
-def test_wrong_config_is_rejected(tmp_path, caplog, section, match):
+def test_wrong_config_is_rejected(tmp_path, capsys, section, match):
     cfg = tmp_path / "bad.yaml"
     cfg.write_text(f"ch3_adaptive_bem:\n  {section}\n")
-    with caplog.at_level(logging.ERROR):
-        rc = cli.main(["run", "figure_3_2", "--config", str(cfg), "--out", str(tmp_path)])
-    assert rc == cli.EXIT_FAILED
-    assert match in caplog.text
+    rc = cli.main(["run", "figure_3_2", "--config", str(cfg), "--out", str(tmp_path)])
+    assert rc == cli.EXIT_USAGE             # a config error is a usage error (exit 2)
+    err = capsys.readouterr().err
+    assert match in err and "bad.yaml" in err

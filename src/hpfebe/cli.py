@@ -11,6 +11,8 @@ import argparse
 import importlib
 import logging
 import os
+import re
+import signal
 import sys
 import time
 from pathlib import Path
@@ -24,6 +26,123 @@ EXIT_OK, EXIT_FAILED, EXIT_USAGE = 0, 1, 2
 
 class CLIError(Exception):
     """A user-facing error: printed without traceback, exit status 2."""
+
+
+# --------------------------------------------------------------------------- signals
+#: environment variable naming the process whose death stops a run (set by the
+#: Snakefile to the Snakemake process running the job)
+PARENT_PID_ENV = "HPFEBE_PARENT_PID"
+
+
+class Terminated(BaseException):
+    """Raised in the main thread by the SIGTERM/SIGHUP handler (a BaseException, like
+    KeyboardInterrupt, so that no ``except Exception`` swallows it); exit 128 + signum."""
+
+    def __init__(self, signum: int, why: str = ""):
+        super().__init__(signum)
+        self.signum, self.why = signum, why
+
+
+def _on_signal(signum, frame):  # noqa: ARG001 - signal handler signature
+    from .results import remove_temporaries
+
+    remove_temporaries()
+    raise Terminated(signum)
+
+
+def install_signal_handlers() -> None:
+    """SIGTERM and SIGHUP end a run like Ctrl-C does: the temporary files of atomic
+    writes in progress are removed, no result file is left half written, and the exit
+    status is 128 + signal number.  (SIGINT raises KeyboardInterrupt, which
+    :func:`hpfebe.results.atomic_write` cleans up the same way; exit 130.)"""
+    for sig in (signal.SIGTERM, getattr(signal, "SIGHUP", None)):
+        if sig is not None:
+            signal.signal(sig, _on_signal)
+
+
+def _start_time(pid: int) -> str | None:
+    """Start time of process ``pid`` (Linux /proc), to tell it from a reused pid."""
+    try:
+        with open(f"/proc/{pid}/stat", encoding="ascii", errors="replace") as f:
+            fields = f.read().rsplit(")", 1)[1].split()
+        return None if fields[0] in ("Z", "X") else fields[19]
+    except (OSError, IndexError):
+        return None
+
+
+def _alive(pid: int, start: str | None) -> bool:
+    if start is not None:                         # Linux: same process, not a zombie
+        return _start_time(pid) == start
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:
+        return True
+    return True
+
+
+def watch_parent(pid: int, interval: float = 1.0, grace: float = 30.0):
+    """Stop this run when process ``pid`` ends (Snakemake killed, even by SIGKILL, must
+    not leave its jobs running on as orphans writing into results/): a daemon thread
+    polls it every ``interval`` seconds and, when it is gone, sends this process
+    SIGTERM (see :func:`install_signal_handlers`); if the main thread has not ended
+    ``grace`` seconds later (stuck in compiled code), the temporaries are removed and
+    the process exits hard with status 143.  Returns the thread; CLIError if ``pid`` is
+    not running now (its Snakemake ended before this job started)."""
+    import threading
+
+    start = _start_time(pid)
+    if not _alive(pid, start):
+        raise CLIError(f"{PARENT_PID_ENV}={pid} names a process that has ended: the "
+                       "Snakemake that started this job is gone, so the job does not run "
+                       f"(to run the command by hand, leave out {PARENT_PID_ENV})")
+
+    def loop():
+        while _alive(pid, start):
+            time.sleep(interval)
+        log.warning("parent process %d is gone: stopping this run", pid)
+        os.kill(os.getpid(), signal.SIGTERM)
+        time.sleep(grace)
+        from .results import remove_temporaries
+
+        remove_temporaries()
+        os._exit(128 + signal.SIGTERM)
+
+    t = threading.Thread(target=loop, name="hpfebe-watch-parent", daemon=True)
+    t.start()
+    return t
+
+
+def _watch_parent_from_env() -> None:
+    value = os.environ.get(PARENT_PID_ENV)
+    if not value:
+        return
+    try:
+        pid = int(value)
+    except ValueError:
+        log.warning("%s=%r is not a process id; ignored", PARENT_PID_ENV, value)
+        return
+    if pid > 1 and pid != os.getpid():
+        watch_parent(pid)
+
+
+def remove_stale_temporaries(out: Path, artefacts) -> list[Path]:
+    """Temporary files ``.<artefact>.<ext>.*.tmp`` left in ``out`` by a run that was
+    killed outright (SIGKILL: no handler can clean up); removed before a new run of the
+    same module writes there."""
+    stale = []
+    if out.is_dir():
+        for a in artefacts:
+            stale += [p for p in out.glob(f".{a}.*.tmp") if p.is_file()]
+            stale += [p for p in out.glob(f".{a}_*.vtu") if p.is_file()]   # export.write_vtu
+    for p in stale:
+        try:
+            p.unlink()
+            log.info("removed stale temporary file %s (an interrupted run)", p)
+        except OSError:
+            pass
+    return stale
 
 
 # --------------------------------------------------------------------------- locating
@@ -75,20 +194,80 @@ def merge(base: dict, over: dict) -> dict:
     return out
 
 
-def load_config(files: list[Path]) -> dict:
+def read_config_files(files: list[Path]) -> list[tuple[Path, dict]]:
+    """Each config file's mapping, in order (CLIError for a missing file, bad YAML or a
+    top level that is not a mapping)."""
     import yaml
 
-    cfg: dict = {}
+    out = []
     for f in files:
         if not f.is_file():
             raise CLIError(f"config file not found: {f}")
-        with open(f, encoding="utf-8") as fh:
-            data = yaml.safe_load(fh) or {}
+        try:
+            with open(f, encoding="utf-8") as fh:
+                data = yaml.safe_load(fh) or {}
+        except yaml.YAMLError as exc:
+            raise CLIError(f"config file {f} is not valid YAML: {exc}") from None
         if not isinstance(data, dict):
             raise CLIError(f"config file {f} must hold a mapping at top level, "
                            f"got {type(data).__name__}")
+        out.append((f, data))
+    return out
+
+
+def load_config(files: list[Path]) -> dict:
+    cfg: dict = {}
+    for _, data in read_config_files(files):
         cfg = merge(cfg, data)
     return cfg
+
+
+def where_set(per_file: list[tuple[Path, dict]], path: str | None) -> str:
+    """Which config files set the dotted ``path`` (``"scene.key[2]"``): for messages."""
+    files = [str(f) for f, _ in per_file]
+    if not path:
+        return "config files: " + ", ".join(files)
+    parts = re.sub(r"\[\d+\]", "", path).split(".")
+    hits = []
+    for f, data in per_file:
+        node = data
+        for key in parts:
+            if not isinstance(node, dict) or key not in node:
+                break
+            node = node[key]
+        else:
+            hits.append(str(f))
+    if not hits:
+        return (f"{parts[-1]!r} is not set in {', '.join(files)}: a default of the "
+                "experiment")
+    last = f"; {hits[-1]} wins" if len(hits) > 1 else ""
+    return f"set in {', '.join(hits)}{last}"
+
+
+def check_top_level(per_file: list[tuple[Path, dict]], config: dict, modules) -> bool:
+    """The merged config's top level: ``quick`` a real bool (``"false"`` is not false),
+    every section a mapping, a section name close to a module name but not one of them
+    (a misspelling) an error; returns ``quick``."""
+    import difflib
+
+    quick = config.get("quick", False)
+    if not isinstance(quick, bool):
+        raise CLIError(f"config key 'quick' must be true or false, got {quick!r} "
+                       f"({where_set(per_file, 'quick')})")
+    modules = sorted(modules)
+    for key, value in config.items():
+        if key == "quick" or key in modules:
+            if key != "quick" and value is not None and not isinstance(value, dict):
+                raise CLIError(f"config section {key!r} must be a mapping, got {value!r} "
+                               f"({where_set(per_file, key)})")
+            continue
+        close = difflib.get_close_matches(str(key), modules, n=1, cutoff=0.8)
+        if close:
+            raise CLIError(f"config section {key!r} is not an experiment module; did you "
+                           f"mean {close[0]!r}? ({where_set(per_file, str(key))})")
+        log.warning("config section %r belongs to no experiment module (%s); ignored",
+                    key, where_set(per_file, str(key)))
+    return quick
 
 
 # --------------------------------------------------------------------------- commands
@@ -157,12 +336,12 @@ def cmd_run(args) -> int:
         files = [root / "config" / "config.yaml"]
         if args.quick:
             files.append(root / "config" / "quick.yaml")
+    per_file = read_config_files(files)
     config = load_config(files)
-    quick = bool(args.quick or config.get("quick", False))
+    quick = check_top_level(per_file, config, [e.name for e in registry]) or args.quick
     section = config.get(exp.name) or {}
-    if not isinstance(section, dict):
-        raise CLIError(f"config section {exp.name!r} must be a mapping, got {section!r}")
     out = Path(args.out) if args.out else root / "results"
+    remove_stale_temporaries(out, exp.artefacts)
 
     import matplotlib
 
@@ -181,8 +360,13 @@ def cmd_run(args) -> int:
 
     log.info("running %s (%s) for %s%s", exp.name, ", ".join(exp.artefacts), args.artefact,
              " [quick]" if quick else "")
+    from .params import ConfigError
+
     t0 = time.perf_counter()
-    results = module.run(section, quick=quick)
+    try:
+        results = module.run(section, quick=quick)
+    except ConfigError as exc:
+        raise CLIError(f"config: {exc} ({where_set(per_file, exc.path)})") from None
     wall = time.perf_counter() - t0
     log.info("%s finished in %.1f s", exp.name, wall)
 
@@ -286,14 +470,23 @@ def main(argv: list[str] | None = None) -> int:
     if not getattr(args, "func", None):
         parser.print_help()
         return EXIT_USAGE
+    install_signal_handlers()
     try:
+        _watch_parent_from_env()
         return args.func(args)
     except CLIError as exc:
         print(f"hpfebe: error: {exc}", file=sys.stderr)
         return EXIT_USAGE
     except KeyboardInterrupt:
-        print("hpfebe: interrupted", file=sys.stderr)
+        from .results import remove_temporaries
+
+        remove_temporaries()
+        print("hpfebe: interrupted (no result file was left half written)", file=sys.stderr)
         return 130
+    except Terminated as exc:
+        print(f"hpfebe: terminated by signal {exc.signum} (no result file was left half "
+              "written)", file=sys.stderr)
+        return 128 + exc.signum
     except Exception:
         log.exception("hpfebe %s failed", args.command)
         return EXIT_FAILED

@@ -6,9 +6,14 @@ contact, or any user string) and its own polynomial degree ``p_I >= 1``.
 
 Orientation: an element runs from its first to its second node; the unit normal is the
 tangent turned clockwise, ``n = (t_y, -t_x)``.  Outer boundaries are counter-clockwise and
-holes clockwise, so that ``n`` is the *outward* normal of the domain (the convention of the
-representation formula (1.2)).  :meth:`BoundaryMesh.polygon` orients a single polygon
-counter-clockwise itself.
+holes clockwise, so that ``n`` is the *outward* normal of a bounded domain (the convention
+of the representation formula (1.2)).  Which curve is a hole follows from nesting (a curve
+inside an odd number of other curves is a hole) and its direction from the sign of its
+enclosed area.  The constructors :meth:`BoundaryMesh.polygon`,
+:meth:`BoundaryMesh.from_segments` and :meth:`BoundaryMesh.join` *orient* every curve this
+way (a reversed element keeps its label and degree); the plain constructor
+``BoundaryMesh(nodes, elements, labels, degrees)`` *refuses* a wrongly oriented curve with a
+ValueError naming it.  A curve enclosing no area (collinear vertices) is refused by all.
 """
 
 from __future__ import annotations
@@ -21,40 +26,179 @@ LABELS = {"D": "Dirichlet", "N": "Neumann", "I": "interface", "C": "contact"}
 
 
 @njit(cache=True)
+def _segments_cross(nodes, elements, k, l):
+    """Whether elements k and l intersect (touching and collinear overlap included);
+    elements sharing a node are never reported."""
+    if (elements[l, 0] == elements[k, 0] or elements[l, 0] == elements[k, 1]
+            or elements[l, 1] == elements[k, 0] or elements[l, 1] == elements[k, 1]):
+        return False
+    a0, a1 = nodes[elements[k, 0]], nodes[elements[k, 1]]
+    b0, b1 = nodes[elements[l, 0]], nodes[elements[l, 1]]
+    if (max(b0[0], b1[0]) < min(a0[0], a1[0]) or min(b0[0], b1[0]) > max(a0[0], a1[0])
+            or max(b0[1], b1[1]) < min(a0[1], a1[1])
+            or min(b0[1], b1[1]) > max(a0[1], a1[1])):
+        return False
+    d1 = (a1[0] - a0[0]) * (b0[1] - a0[1]) - (a1[1] - a0[1]) * (b0[0] - a0[0])
+    d2 = (a1[0] - a0[0]) * (b1[1] - a0[1]) - (a1[1] - a0[1]) * (b1[0] - a0[0])
+    d3 = (b1[0] - b0[0]) * (a0[1] - b0[1]) - (b1[1] - b0[1]) * (a0[0] - b0[0])
+    d4 = (b1[0] - b0[0]) * (a1[1] - b0[1]) - (b1[1] - b0[1]) * (a1[0] - b0[0])
+    if d1 * d2 <= 0.0 and d3 * d4 <= 0.0:
+        # collinear disjoint segments give all d = 0: check the projections overlap
+        if d1 == 0.0 and d2 == 0.0:
+            ax = a1[0] - a0[0]
+            ay = a1[1] - a0[1]
+            la = ax * ax + ay * ay
+            t0 = ((b0[0] - a0[0]) * ax + (b0[1] - a0[1]) * ay) / la
+            t1 = ((b1[0] - a0[0]) * ax + (b1[1] - a0[1]) * ay) / la
+            if max(t0, t1) < 0.0 or min(t0, t1) > 1.0:
+                return False
+        return True
+    return False
+
+
+@njit(cache=True)
+def _grid_cells(nodes, elements, x0, y0, c, ny, pad, fill, keys, owner):
+    """Cells of a uniform grid (size ``c``, origin ``(x0, y0)``) met by each element:
+    column by column, the y-range of the segment inside the column (padded by ``pad``).
+    Returns the number of (cell, element) pairs; fills ``keys``/``owner`` if ``fill``."""
+    cnt = 0
+    for k in range(elements.shape[0]):
+        ax, ay = nodes[elements[k, 0], 0], nodes[elements[k, 0], 1]
+        bx, by = nodes[elements[k, 1], 0], nodes[elements[k, 1], 1]
+        i0 = int(np.floor((min(ax, bx) - pad - x0) / c))
+        i1 = int(np.floor((max(ax, bx) + pad - x0) / c))
+        for i in range(i0, i1 + 1):
+            if ax == bx:
+                ylo, yhi = min(ay, by), max(ay, by)
+            else:
+                xl = max(min(ax, bx), x0 + i * c)
+                xr = min(max(ax, bx), x0 + (i + 1) * c)
+                yl = ay + (by - ay) * (xl - ax) / (bx - ax)
+                yr = ay + (by - ay) * (xr - ax) / (bx - ax)
+                ylo, yhi = min(yl, yr), max(yl, yr)
+            j0 = int(np.floor((ylo - pad - y0) / c))
+            j1 = int(np.floor((yhi + pad - y0) / c))
+            for j in range(j0, j1 + 1):
+                if fill:
+                    keys[cnt] = i * ny + j
+                    owner[cnt] = k
+                cnt += 1
+    return cnt
+
+
+@njit(cache=True)
+def _first_crossing_in_cells(nodes, elements, owner, starts):
+    """Smallest pair (k, l), k < l, of crossing elements registered in one grid cell
+    (cell g holds ``owner[starts[g]:starts[g + 1]]``), or (-1, -1)."""
+    bk, bl = -1, -1
+    for g in range(starts.shape[0] - 1):
+        for s in range(starts[g], starts[g + 1]):
+            for t in range(s + 1, starts[g + 1]):
+                k, l = min(owner[s], owner[t]), max(owner[s], owner[t])
+                if k == l or (bk >= 0 and (k > bk or (k == bk and l >= bl))):
+                    continue
+                if _segments_cross(nodes, elements, k, l):
+                    bk, bl = k, l
+    return bk, bl
+
+
 def _first_crossing(nodes, elements):
     """First pair (k, l) of elements that intersect without sharing a node, or (-1, -1).
 
-    O(ne^2) with a bounding-box early exit; runs once per user-built mesh (refinement
-    cannot create crossings)."""
-    ne = elements.shape[0]
-    for k in range(ne):
-        a0, a1 = nodes[elements[k, 0]], nodes[elements[k, 1]]
-        axmin, axmax = min(a0[0], a1[0]), max(a0[0], a1[0])
-        aymin, aymax = min(a0[1], a1[1]), max(a0[1], a1[1])
-        for l in range(k + 1, ne):
-            if (elements[l, 0] == elements[k, 0] or elements[l, 0] == elements[k, 1]
-                    or elements[l, 1] == elements[k, 0] or elements[l, 1] == elements[k, 1]):
-                continue
-            b0, b1 = nodes[elements[l, 0]], nodes[elements[l, 1]]
-            if (max(b0[0], b1[0]) < axmin or min(b0[0], b1[0]) > axmax
-                    or max(b0[1], b1[1]) < aymin or min(b0[1], b1[1]) > aymax):
-                continue
-            d1 = (a1[0] - a0[0]) * (b0[1] - a0[1]) - (a1[1] - a0[1]) * (b0[0] - a0[0])
-            d2 = (a1[0] - a0[0]) * (b1[1] - a0[1]) - (a1[1] - a0[1]) * (b1[0] - a0[0])
-            d3 = (b1[0] - b0[0]) * (a0[1] - b0[1]) - (b1[1] - b0[1]) * (a0[0] - b0[0])
-            d4 = (b1[0] - b0[0]) * (a1[1] - b0[1]) - (b1[1] - b0[1]) * (a1[0] - b0[0])
-            if d1 * d2 <= 0.0 and d3 * d4 <= 0.0:
-                # collinear disjoint segments give all d = 0: check the projections overlap
-                if d1 == 0.0 and d2 == 0.0:
-                    ax = a1[0] - a0[0]
-                    ay = a1[1] - a0[1]
-                    la = ax * ax + ay * ay
-                    t0 = ((b0[0] - a0[0]) * ax + (b0[1] - a0[1]) * ay) / la
-                    t1 = ((b1[0] - a0[0]) * ax + (b1[1] - a0[1]) * ay) / la
-                    if max(t0, t1) < 0.0 or min(t0, t1) > 1.0:
-                        continue
-                return k, l
-    return -1, -1
+    Near-linear: the elements are registered in the cells of a uniform grid of the mean
+    element length that they pass through, and only elements sharing a cell are tested
+    (expected O(ne) for meshes without strong grading; O(k^2) in a cell holding k
+    elements)."""
+    a, b = nodes[elements[:, 0]], nodes[elements[:, 1]]
+    lengths = np.linalg.norm(b - a, axis=1)
+    lo = np.minimum(a, b).min(axis=0)
+    hi = np.maximum(a, b).max(axis=0)
+    c = max(float(lengths.mean()), 1e-6 * float((hi - lo).max()), np.finfo(float).tiny)
+    pad = 1e-9 * c
+    x0, y0 = lo[0] - c, lo[1] - c
+    ny = int(np.floor((hi[1] + pad - y0) / c)) + 2
+    empty_i = np.zeros(0, dtype=np.int64)
+    cnt = _grid_cells(nodes, elements, x0, y0, c, ny, pad, False, empty_i, empty_i)
+    keys = np.empty(cnt, dtype=np.int64)
+    owner = np.empty(cnt, dtype=np.int64)
+    _grid_cells(nodes, elements, x0, y0, c, ny, pad, True, keys, owner)
+    order = np.argsort(keys, kind="stable")
+    keys, owner = keys[order], owner[order]
+    starts = np.flatnonzero(np.r_[True, keys[1:] != keys[:-1], True]).astype(np.int64)
+    k, l = _first_crossing_in_cells(nodes, elements, owner, starts)
+    return int(k), int(l)
+
+
+def _curve_index(elements: np.ndarray, n_nodes: int) -> np.ndarray:
+    """Curve number of every element (connected components of the element graph,
+    numbered in the order of their first element)."""
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+
+    g = coo_matrix((np.ones(len(elements)), (elements[:, 0], elements[:, 1])),
+                   shape=(n_nodes, n_nodes))
+    _, comp = connected_components(g, directed=False)
+    comp = comp[elements[:, 0]]
+    _, first, inv = np.unique(comp, return_index=True, return_inverse=True)
+    rank = np.empty(len(first), dtype=np.int64)
+    rank[np.argsort(first)] = np.arange(len(first))
+    return rank[inv]
+
+
+def _curve_orientation(nodes, elements, curve, scale):
+    """Per curve: twice its signed area (> 0 counter-clockwise) and its nesting depth
+    (the number of other curves enclosing it; even = an outer boundary, odd = a hole).
+
+    ValueError for a curve enclosing no area (collinear vertices)."""
+    a, b = nodes[elements[:, 0]], nodes[elements[:, 1]]
+    nc = int(curve.max()) + 1
+    area2 = np.bincount(curve, a[:, 0] * b[:, 1] - b[:, 0] * a[:, 1], minlength=nc)
+    for c in np.flatnonzero(np.abs(area2) <= 1e-12 * scale ** 2):
+        el = np.flatnonzero(curve == c)
+        raise ValueError(f"curve {c} (elements {_span(el)}) encloses zero area: its "
+                         "vertices are collinear")
+    depth = np.zeros(nc, dtype=np.int64)
+    if nc > 1:
+        probe = a[np.unique(curve, return_index=True)[1]]        # one node per curve
+        for c in range(nc):   # crossing number of a ray to +x from every probe
+            on = curve == c
+            ya, yb, xa, xb = a[on, 1], b[on, 1], a[on, 0], b[on, 0]
+            py, px = probe[:, 1:2], probe[:, 0:1]
+            straddle = (ya <= py) != (yb <= py)
+            with np.errstate(divide="ignore", invalid="ignore"):
+                xc = xa + (py - ya) * (xb - xa) / (yb - ya)
+            inside = (np.count_nonzero(straddle & (xc > px), axis=1) % 2) == 1
+            inside[c] = False
+            depth += inside
+    return area2, depth
+
+
+def _span(idx) -> str:
+    idx = np.asarray(idx)
+    if len(idx) and idx[-1] - idx[0] == len(idx) - 1:
+        return f"{idx[0]}..{idx[-1]}"
+    return str(idx.tolist()[:8])[:-1] + (", ...]" if len(idx) > 8 else "]")
+
+
+def _as_degrees(p, name: str = "p") -> np.ndarray:
+    """Integer degrees from ``p`` (scalar or array); ValueError for booleans, non-integer
+    or non-finite values (never truncated: 2.7 is not 2, True is not 1)."""
+    if not isinstance(p, np.ndarray):
+        flat = p if isinstance(p, (list, tuple)) else [p]
+        if any(isinstance(x, (bool, np.bool_)) for x in flat):
+            raise ValueError(f"{name} must be integer degrees >= 1, got a boolean in {p!r}")
+    arr = np.asarray(p)
+    if arr.dtype.kind == "b":
+        raise ValueError(f"{name} must be integer degrees >= 1, got booleans")
+    if arr.dtype.kind in "iu":
+        return arr.astype(np.int64)
+    if arr.dtype.kind != "f":
+        raise ValueError(f"{name} must be integer degrees >= 1, got {p!r}")
+    bad = ~np.isfinite(arr) | (arr != np.round(arr))
+    if np.any(bad):
+        raise ValueError(f"{name} must be integer degrees >= 1, got "
+                         f"{arr[bad].ravel()[0]!r} (degrees are never rounded)")
+    return arr.astype(np.int64)
 
 
 def _as_per_side(value, nsides: int, name: str):
@@ -87,6 +231,7 @@ class BoundaryMesh:
     labels: np.ndarray
     degrees: np.ndarray
     _checked: bool = field(default=False, repr=False)
+    _orient: bool = field(default=False, repr=False)
     parent: np.ndarray | None = field(default=None, repr=False)
     parent_mesh: "BoundaryMesh | None" = field(default=None, repr=False)
 
@@ -94,7 +239,9 @@ class BoundaryMesh:
         nodes = np.ascontiguousarray(self.nodes, dtype=float)
         elements = np.ascontiguousarray(self.elements, dtype=np.int64)
         labels = np.asarray(self.labels, dtype=str)
-        degrees = np.ascontiguousarray(self.degrees, dtype=np.int64)
+        degrees = np.ascontiguousarray(
+            self.degrees if self._checked else _as_degrees(self.degrees, "degrees"),
+            dtype=np.int64)
         for name, arr in (("nodes", nodes), ("elements", elements), ("labels", labels),
                           ("degrees", degrees)):
             arr.setflags(write=False)
@@ -161,20 +308,55 @@ class BoundaryMesh:
         k, l = _first_crossing(nodes, elements)
         if k >= 0:
             raise ValueError(f"self-intersecting boundary: elements {k} and {l} cross")
+        self._check_orientation(scale)
+
+    def _check_orientation(self, scale: float):
+        """Outer curves counter-clockwise, holes clockwise: flip wrongly oriented curves
+        if ``_orient`` (reversing their elements in place, with labels and degrees),
+        else ValueError naming the first wrong curve."""
+        curve = _curve_index(self.elements, len(self.nodes))
+        area2, depth = _curve_orientation(self.nodes, self.elements, curve, scale)
+        wrong = np.flatnonzero(np.sign(area2) != np.where(depth % 2 == 0, 1.0, -1.0))
+        if wrong.size == 0:
+            return
+        if not self._orient:
+            c = int(wrong[0])
+            el = np.flatnonzero(curve == c)
+            kind = "an outer boundary" if depth[c] % 2 == 0 else \
+                f"a hole (inside {depth[c]} other curve(s))"
+            want = "counter-clockwise" if depth[c] % 2 == 0 else "clockwise"
+            raise ValueError(
+                f"wrongly oriented curve {c} (elements {_span(el)}, from node "
+                f"{self.elements[el[0], 0]} at {self.nodes[self.elements[el[0], 0]].tolist()})"
+                f": it is {kind} and must run {want} so that the normal points out of the "
+                "domain; reverse its elements, or build the mesh with "
+                "BoundaryMesh.from_segments / join / polygon, which orient every curve")
+        perm = np.arange(self.n_elements)
+        for c in wrong:   # reverse the order of the curve's elements within their slots
+            el = np.flatnonzero(curve == c)
+            perm[el] = el[::-1]
+        elements = self.elements[perm].copy()
+        flip = np.isin(curve[perm], wrong)
+        elements[flip] = elements[flip][:, ::-1]
+        for name, arr in (("elements", np.ascontiguousarray(elements)),
+                          ("labels", self.labels[perm]), ("degrees", self.degrees[perm])):
+            arr.setflags(write=False)
+            object.__setattr__(self, name, arr)
 
     # ------------------------------------------------------------------ constructors
     @classmethod
     def from_segments(cls, nodes, segments, labels="N", p=1) -> "BoundaryMesh":
         """Mesh from explicit nodes and segments (any number of closed curves).
 
-        ``labels`` and ``p`` are one value for all or one per segment."""
+        ``labels`` and ``p`` are one value for all or one per segment.  Every curve is
+        oriented (outer curves counter-clockwise, holes clockwise; see the module
+        docstring): the elements of a wrongly oriented curve are reversed, keeping
+        their labels and degrees, so ``mesh.elements`` may differ from ``segments``."""
         segments = np.asarray(segments)
         ne = len(segments)
         labels = np.asarray(_as_per_side(labels, ne, "labels"), dtype=str)
-        degrees = np.asarray(_as_per_side(p, ne, "p"))
-        if np.any(degrees != np.round(degrees)):
-            raise ValueError(f"p must be integer degrees >= 1, got {p!r}")
-        return cls(nodes, segments, labels, degrees.astype(np.int64))
+        degrees = _as_degrees(_as_per_side(p, ne, "p"), "p")
+        return cls(nodes, segments, labels, degrees, _orient=True)
 
     @classmethod
     def polygon(cls, vertices, n=None, h=None, labels="N", p=1) -> "BoundaryMesh":
@@ -189,7 +371,11 @@ class BoundaryMesh:
         labels : str or list of str, one label per side (side k joins vertex k and k+1)
         p : int or list of int, polynomial degree per side
         """
-        v = np.asarray(vertices, dtype=float)
+        try:
+            v = np.asarray(vertices, dtype=float)
+        except (TypeError, ValueError):
+            raise ValueError(f"vertices must be an (m, 2) array of numbers, got "
+                             f"{vertices!r}") from None
         if v.ndim != 2 or v.shape[1] != 2 or len(v) < 3:
             raise ValueError(f"vertices must have shape (m, 2) with m >= 3, got {v.shape}")
         m = len(v)
@@ -200,21 +386,21 @@ class BoundaryMesh:
         if n is not None:
             ns = _as_per_side(n, m, "n")
             for k in ns:
-                if int(k) != k or k < 1:
+                if isinstance(k, (bool, np.bool_)) or not isinstance(
+                        k, (int, float, np.integer, np.floating)) or not np.isfinite(k) \
+                        or int(k) != k or k < 1:
                     raise ValueError(f"n (elements per side) must be integers >= 1, got {n!r}")
         else:
             hs = _as_per_side(h, m, "h")
             for k in hs:
-                if not (np.isfinite(k) and k > 0):
+                if isinstance(k, (bool, np.bool_)) or not isinstance(
+                        k, (int, float, np.integer, np.floating)) or not (
+                        np.isfinite(k) and k > 0):
                     raise ValueError(f"h (element size) must be positive, got {h!r}")
-        area2 = np.sum(v[:, 0] * np.roll(v[:, 1], -1) - np.roll(v[:, 0], -1) * v[:, 1])
+        ps = list(_as_degrees(ps, "p"))
         side_len = np.linalg.norm(np.roll(v, -1, axis=0) - v, axis=1)
         if n is None:
             ns = [max(1, int(np.ceil(L / hk - 1e-9))) for L, hk in zip(side_len, hs)]
-        if area2 < 0:  # clockwise: reverse, side k (v_k -> v_k+1) becomes side m-1-k
-            v = v[::-1]
-            rev = lambda a: list(a)[::-1]  # noqa: E731
-            labels, ps, ns = rev(labels), rev(ps), rev(ns)
         pts, lab, deg = [], [], []
         for k in range(m):
             t = np.arange(int(ns[k]))[:, None] / int(ns[k])
@@ -224,16 +410,27 @@ class BoundaryMesh:
         nodes = np.vstack(pts)
         ne = len(nodes)
         seg = np.column_stack([np.arange(ne), (np.arange(ne) + 1) % ne])
+        # side k joins v_k and v_k+1 as given; from_segments reverses a clockwise polygon
+        # element by element, so each side keeps its label, element count and degree
         return cls.from_segments(nodes, seg, lab, deg)
 
     @classmethod
     def join(cls, *meshes: "BoundaryMesh") -> "BoundaryMesh":
-        """Several closed curves in one mesh (e.g. an outer boundary and a hole)."""
+        """Several closed curves in one mesh (e.g. an outer boundary and a hole).
+
+        Every curve is oriented by nesting (see the module docstring): a hole built with
+        :meth:`polygon` (counter-clockwise) is reversed to run clockwise."""
+        for k, m in enumerate(meshes):
+            if not isinstance(m, BoundaryMesh):
+                raise ValueError(f"meshes[{k}] must be a BoundaryMesh, got "
+                                 f"{type(m).__name__}")
+        if not meshes:
+            raise ValueError("join needs at least one BoundaryMesh")
         offs = np.cumsum([0] + [len(m.nodes) for m in meshes])
         return cls(np.vstack([m.nodes for m in meshes]),
                    np.vstack([m.elements + o for m, o in zip(meshes, offs)]),
                    np.concatenate([m.labels for m in meshes]),
-                   np.concatenate([m.degrees for m in meshes]))
+                   np.concatenate([m.degrees for m in meshes]), _orient=True)
 
     # ------------------------------------------------------------------ geometry
     @property
@@ -379,7 +576,13 @@ class BoundaryMesh:
     def with_degrees(self, p) -> "BoundaryMesh":
         """The same mesh with degree ``p`` (scalar or per element); its ``parent`` is the
         identity map into this mesh."""
-        p = np.broadcast_to(np.asarray(p), (self.n_elements,)).astype(np.int64)
+        try:
+            p = np.broadcast_to(_as_degrees(p, "p"), (self.n_elements,))
+        except ValueError as err:
+            if "broadcast" not in str(err):
+                raise
+            raise ValueError(f"p must be a scalar or one degree per element "
+                             f"({self.n_elements})") from None
         if p.min() < 1:
             raise ValueError(f"degree p must be >= 1, got {p.min()}")
         return self._replace(degrees=p.copy(), parent=np.arange(self.n_elements),

@@ -103,4 +103,9 @@ def from_config(cls, section: dict | None, scene: str = "config"):
         raise ConfigError(f"config section {scene!r}: unknown key(s) {unknown}; "
                           f"allowed: {sorted(names)}", f"{scene}.{unknown[0]}")
     values = {k: _check(v, hints[k], f"{scene}.{k}") for k, v in section.items()}
-    return cls(**values)
+    try:
+        return cls(**values)
+    except ConfigError:
+        raise
+    except ValueError as e:          # a range check of the parameter object
+        raise ConfigError(f"config section {scene!r}: {e}", scene) from None

@@ -12,7 +12,10 @@ differing, wall time).  Per table artefact with a published file: published |
 reproduced | difference | status for every column with a tolerance, joined on the
 result's ``keys`` (rows on one side only are marked "not run" / "not published").
 Per artefact: the figure, the thesis's claims with verdict and evidence, the notes, the
-reproduced table.  Footer: provenance.  Missing results are marked "not built".
+reproduced table.  Footer: provenance.  Missing results are marked "not built"; a
+result whose files do not match what its JSON records (JSON not an object, truncated or
+changed CSV, empty or changed PNG: :func:`hpfebe.results.check_result`) is marked
+"damaged" with the mismatches, and none of its numbers or figures is used.
 
 An edge module: no numerics beyond comparing numbers.
 """
@@ -31,7 +34,8 @@ from pathlib import Path
 
 import pandas as pd
 
-from .results import artefact_kind, atomic_write, published_file_for
+from .results import DamagedResult, artefact_kind, atomic_write, check_result, \
+    published_file_for
 
 __all__ = ["build_report", "compare", "collect"]
 
@@ -46,6 +50,7 @@ STATUS_NOT_IMPL = "not implemented"
 STATUS_NO_OVERLAP = "no rows in common"
 STATUS_PUB_MISSING = "published file missing"
 STATUS_UNREADABLE = "unreadable result"
+STATUS_DAMAGED = "damaged"
 
 
 # --------------------------------------------------------------------------- data
@@ -247,11 +252,25 @@ def collect(results_dir: Path, published_dir: Path,
     for name in sorted(names, key=_sort_key):
         kind = artefact_kind(name)
         module = expected.get(name)
-        js, csv, png = (results_dir / f"{name}.{e}" for e in ("json", "csv", "png"))
-        if not (js.is_file() and csv.is_file()):
-            status = STATUS_NOT_BUILT if (module or js.exists() or csv.exists()) else (
-                STATUS_NOT_IMPL if name in pub_only else STATUS_NOT_BUILT)
-            e = Entry(name, kind, module, status)
+        js, csv = (results_dir / f"{name}.{e}" for e in ("json", "csv"))
+        checked, damage = None, ""
+        if js.is_file():
+            try:
+                checked = check_result(results_dir, name)
+            except DamagedResult as exc:
+                damage = "; ".join(exc.problems)
+            except Exception as exc:  # noqa: BLE001 - shown in the report
+                damage = f"cannot be read: {exc}"
+        if checked is None:
+            if damage:
+                status = STATUS_DAMAGED
+            else:
+                status = STATUS_NOT_BUILT if (module or js.exists() or csv.exists()) else (
+                    STATUS_NOT_IMPL if name in pub_only else STATUS_NOT_BUILT)
+            e = Entry(name, kind, module, status,
+                      error=f"damaged result, not used: {damage}. Rerun its module "
+                            "(snakemake reruns it once the damaged files are deleted)"
+                      if damage else "")
             e.published_path = published_file_for(name, published_dir)
             if e.published_path:
                 try:
@@ -261,16 +280,10 @@ def collect(results_dir: Path, published_dir: Path,
                     pass
             entries.append(e)
             continue
-        try:
-            with open(js, encoding="utf-8") as f:
-                doc = json.load(f)
-            table = pd.read_csv(csv)
-        except Exception as exc:  # noqa: BLE001 - shown in the report
-            entries.append(Entry(name, kind, module, STATUS_UNREADABLE, error=str(exc)))
-            continue
-        module = module or ((doc.get("provenance") or {}).get("run") or {}).get("module")
-        e = Entry(name, kind, module, "", doc=doc, table=table,
-                  png=png if png.is_file() else None)
+        doc, table, png = checked
+        run = doc.get("provenance") if isinstance(doc.get("provenance"), dict) else {}
+        module = module or (run.get("run") or {}).get("module")
+        e = Entry(name, kind, module, "", doc=doc, table=table, png=png)
         pub_name = doc.get("published")
         if pub_name:
             e.published_path = published_dir / pub_name
@@ -502,7 +515,8 @@ def _e(s) -> str:
 def _status_class(status: str) -> str:
     if status == STATUS_MATCH:
         return "st-match"
-    if status.startswith("differs") or status in (STATUS_PUB_MISSING, STATUS_UNREADABLE):
+    if status.startswith("differs") or status in (STATUS_PUB_MISSING, STATUS_UNREADABLE,
+                                                  STATUS_DAMAGED):
         return "st-diff"
     return "st-none"
 

@@ -9,7 +9,12 @@ figure it produces); :func:`write_result` turns each into
 
 Every file is written atomically (temporary file in the same directory, fsync,
 ``os.replace``): an interrupted run never leaves a half-written file under the final
-name.  The JSON file is written last, so a result is complete when its JSON exists.
+name, and the temporary file is removed on any exception and, through
+:func:`remove_temporaries`, by the command line's SIGTERM/SIGINT handler.  The JSON file
+is written last, so a result is complete when its JSON exists.  The JSON records what
+the result holds (``n_rows``, ``columns``, ``has_figure`` and, under ``files``, the size
+and sha256 of the CSV and PNG written); :func:`check_result` compares the files against
+it, so that a truncated, replaced or emptied file is found "damaged" and never used.
 
 Claims that recur are built by helpers, so that the verdict and its evidence read the
 same everywhere: :func:`rate_claim` (an observed rate against the expected one),
@@ -24,6 +29,8 @@ file writing.
 
 from __future__ import annotations
 
+import hashlib
+import io
 import json
 import math
 import os
@@ -49,7 +56,10 @@ __all__ = [
     "ArtefactResult",
     "write_result",
     "read_result",
+    "check_result",
+    "DamagedResult",
     "atomic_write",
+    "remove_temporaries",
     "provenance",
     "progress",
     "TOLERANCE_KINDS",
@@ -263,13 +273,35 @@ def _umask() -> int:
     return mask
 
 
+#: temporary files of atomic writes in progress (removed by remove_temporaries)
+_ACTIVE_TEMPORARIES: set[str] = set()
+
+
+def remove_temporaries() -> list[str]:
+    """Remove the temporary files of atomic writes in progress (for a signal handler:
+    the process is about to exit).  Returns the paths removed."""
+    removed = []
+    for tmp in list(_ACTIVE_TEMPORARIES):
+        try:
+            os.unlink(tmp)
+            removed.append(tmp)
+        except OSError:
+            pass
+        _ACTIVE_TEMPORARIES.discard(tmp)
+    return removed
+
+
 def atomic_write(path: Path | str, writer: Callable[[Any], None], mode: str = "w") -> Path:
     """Write ``path`` atomically: ``writer(f)`` fills a temporary file in the same
-    directory, which is flushed, fsync'ed and renamed over ``path``.  If ``writer``
-    raises, the temporary file is removed and ``path`` is left as it was."""
+    directory, which is flushed, fsync'ed and renamed over ``path``.  If anything
+    raises (``BaseException``: also KeyboardInterrupt, SystemExit and the command line's
+    signal exits), the temporary file is removed and ``path`` is left as it was; while
+    the write is in progress the temporary file is registered for
+    :func:`remove_temporaries`."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+    _ACTIVE_TEMPORARIES.add(tmp)
     try:
         os.chmod(tmp, 0o666 & ~_umask())  # mkstemp makes 0600; give the usual mode
         with os.fdopen(fd, mode, **({} if "b" in mode else {"encoding": "utf-8",
@@ -284,6 +316,8 @@ def atomic_write(path: Path | str, writer: Callable[[Any], None], mode: str = "w
         except FileNotFoundError:
             pass
         raise
+    finally:
+        _ACTIVE_TEMPORARIES.discard(tmp)
     try:  # make the rename itself durable (best effort, not on every platform)
         dfd = os.open(path.parent, os.O_RDONLY)
         try:
@@ -400,13 +434,18 @@ def write_result(result: ArtefactResult, out_dir: Path | str, config: dict | Non
 
     table = result.table.copy()
     table.columns = [str(c) for c in table.columns]
-    written.append(atomic_write(out / f"{result.name}.csv",
-                                lambda f: table.to_csv(f, index=False)))
+    csv_bytes = table.to_csv(index=False).encode("utf-8")
+    written.append(atomic_write(out / f"{result.name}.csv", lambda f: f.write(csv_bytes),
+                                mode="wb"))
+    files = {"csv": _file_record(written[-1].name, csv_bytes), "png": None}
 
     png = out / f"{result.name}.png"
     if result.figure is not None:
-        written.append(atomic_write(png, lambda f: result.figure.savefig(
-            f, format="png", dpi=120, bbox_inches="tight"), mode="wb"))
+        buf = io.BytesIO()
+        result.figure.savefig(buf, format="png", dpi=120, bbox_inches="tight")
+        png_bytes = buf.getvalue()
+        written.append(atomic_write(png, lambda f: f.write(png_bytes), mode="wb"))
+        files["png"] = _file_record(png.name, png_bytes)
     elif png.exists():  # a stale figure from an earlier run would be mistaken as current
         png.unlink()
 
@@ -433,6 +472,7 @@ def write_result(result: ArtefactResult, out_dir: Path | str, config: dict | Non
         "columns": list(table.columns),
         "n_rows": int(len(table)),
         "has_figure": result.figure is not None,
+        "files": files,
         "exports": exports,
         "provenance": provenance(config, run_info),
     }
@@ -450,16 +490,120 @@ def artefact_kind(name: str) -> str:
     return "other"
 
 
+def _file_record(name: str, data: bytes) -> dict:
+    return {"name": name, "bytes": len(data), "sha256": hashlib.sha256(data).hexdigest()}
+
+
+class DamagedResult(ValueError):
+    """A result whose files do not match what its JSON says it holds; ``problems``
+    lists every mismatch."""
+
+    def __init__(self, name: str, problems: list[str]):
+        super().__init__(f"{name}: damaged result: " + "; ".join(problems))
+        self.name, self.problems = name, problems
+
+
+_PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
+
+
+def _check_file(path: Path, record, what: str, problems: list[str]) -> bytes | None:
+    """The bytes of ``path`` if it matches ``record`` (size and sha256 from the JSON;
+    None = not recorded, by an older writer), else None with the mismatch in
+    ``problems``."""
+    if not path.is_file():
+        problems.append(f"{what} file {path.name} is missing")
+        return None
+    data = path.read_bytes()
+    if not data:
+        problems.append(f"{what} file {path.name} is empty (0 bytes)")
+        return None
+    if isinstance(record, dict):
+        if record.get("bytes") is not None and record.get("bytes") != len(data):
+            problems.append(f"{what} file {path.name} has {len(data)} bytes, the JSON "
+                            f"records {record.get('bytes')}")
+            return None
+        if record.get("sha256") and record["sha256"] != hashlib.sha256(data).hexdigest():
+            problems.append(f"{what} file {path.name}: sha256 differs from the one "
+                            "recorded in the JSON (changed after it was written)")
+            return None
+    return data
+
+
+def check_result(results_dir: Path | str, name: str
+                 ) -> tuple[dict, pd.DataFrame, Path | None] | None:
+    """The checked JSON document, table and figure path (None if the result has no
+    figure) of a written result; None if its JSON is missing (not built, or
+    interrupted before the JSON was written).
+
+    Raises :class:`DamagedResult` listing every mismatch if the JSON is not a JSON
+    object, or the CSV/PNG do not match what the JSON records (size and sha256 of the
+    files written, row count, columns, figure present; a PNG must be a PNG)."""
+    d = Path(results_dir)
+    js, csv, png = d / f"{name}.json", d / f"{name}.csv", d / f"{name}.png"
+    if not js.exists():
+        return None
+    try:
+        with open(js, encoding="utf-8") as f:
+            doc = json.load(f)
+    except (OSError, ValueError) as exc:
+        raise DamagedResult(name, [f"{js.name} is not valid JSON ({exc})"]) from None
+    if not isinstance(doc, dict):
+        raise DamagedResult(name, [f"{js.name} holds a JSON {type(doc).__name__}, not an "
+                                   "object"])
+    problems: list[str] = []
+    for key, tp, what in (("claims", list, "a list"), ("meta", dict, "an object"),
+                          ("provenance", dict, "an object"), ("notes", str, "a string"),
+                          ("keys", list, "a list"), ("tolerances", dict, "an object"),
+                          ("files", dict, "an object")):
+        if doc.get(key) is not None and not isinstance(doc[key], tp):
+            problems.append(f"{js.name}: {key!r} must be {what}, got "
+                            f"{type(doc[key]).__name__}")
+    run = doc["provenance"].get("run") if isinstance(doc.get("provenance"), dict) else None
+    if run is not None and not isinstance(run, dict):
+        problems.append(f"{js.name}: 'provenance.run' must be an object")
+    if isinstance(doc.get("claims"), list) and not all(
+            isinstance(c, dict) for c in doc["claims"]):
+        problems.append(f"{js.name}: every claim must be an object")
+    if problems:
+        raise DamagedResult(name, problems)
+    files = doc.get("files") if isinstance(doc.get("files"), dict) else {}
+    data = _check_file(csv, files.get("csv"), "table", problems)
+    table = None
+    if data is not None:
+        try:
+            table = pd.read_csv(io.BytesIO(data))
+        except Exception as exc:  # noqa: BLE001 - any parse failure is damage
+            problems.append(f"table file {csv.name} cannot be read ({exc})")
+    if table is not None:
+        cols = doc.get("columns")
+        if isinstance(cols, list) and [str(c) for c in table.columns] != cols:
+            problems.append(f"table columns {list(table.columns)} differ from the JSON's "
+                            f"{cols}")
+        n = doc.get("n_rows")
+        if isinstance(n, int) and len(table) != n:
+            problems.append(f"table has {len(table)} rows, the JSON records {n}")
+    png_path = None
+    if doc.get("has_figure"):
+        img = _check_file(png, files.get("png"), "figure", problems)
+        if img is not None and not img.startswith(_PNG_SIGNATURE):
+            problems.append(f"figure file {png.name} is not a PNG image")
+        elif img is not None:
+            png_path = png
+    if problems:
+        raise DamagedResult(name, problems)
+    return doc, table, png_path
+
+
 def read_result(results_dir: Path | str, name: str) -> tuple[dict, pd.DataFrame] | None:
     """The JSON document and the table of a written result, or None if either is
-    missing (not built, or interrupted before the JSON was written)."""
+    missing (not built, or interrupted before the JSON was written); DamagedResult
+    (a ValueError) if the files do not match what the JSON records (see
+    :func:`check_result`)."""
     d = Path(results_dir)
-    js, csv = d / f"{name}.json", d / f"{name}.csv"
-    if not (js.exists() and csv.exists()):
+    if not (d / f"{name}.json").exists() or not (d / f"{name}.csv").exists():
         return None
-    with open(js, encoding="utf-8") as f:
-        doc = json.load(f)
-    return doc, pd.read_csv(csv)
+    doc, table, _ = check_result(d, name)
+    return doc, table
 
 
 def published_file_for(name: str, published_dir: Path) -> Path | None:

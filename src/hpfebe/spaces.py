@@ -89,10 +89,20 @@ def eval_basis(kind, p, t, gll_x, gll_b, out):
         out[j] /= s
 
 
+def _degree(p, minimum: int = 1) -> int:
+    """``p`` as an int >= ``minimum``; ValueError for booleans and non-integers (never
+    truncated: 2.7 is not 2, True is not 1)."""
+    if (isinstance(p, (bool, np.bool_))
+            or not isinstance(p, (int, float, np.integer, np.floating))
+            or not np.isfinite(p) or p != int(p) or p < minimum):
+        raise ValueError(f"degree p must be an integer >= {minimum}, got {p!r}")
+    return int(p)
+
+
 def lagrange_values(p: int, t: np.ndarray, derivative: bool = False) -> np.ndarray:
     """GLL Lagrange basis of degree p at points t, shape (len(t), p+1) (numpy)."""
     t = np.atleast_1d(np.asarray(t, dtype=float))
-    coef = _lagrange_legendre_coef(int(p), bool(derivative))
+    coef = _lagrange_legendre_coef(_degree(p), bool(derivative))
     return npleg.legvander(t, coef.shape[0] - 1) @ coef
 
 
@@ -113,6 +123,7 @@ def _lagrange_legendre_coef(p: int, derivative: bool) -> np.ndarray:
 def legendre_values(p: int, t: np.ndarray, derivative: bool = False) -> np.ndarray:
     """Legendre P_0..P_{p-1} at points t, shape (len(t), p) (numpy)."""
     t = np.atleast_1d(np.asarray(t, dtype=float))
+    p = _degree(p)
     coef = np.eye(p)
     if derivative:
         der = np.zeros((p, p))

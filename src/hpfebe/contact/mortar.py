@@ -1,7 +1,10 @@
-"""hp-mortar BEM for two-body contact with friction (Section 4.3.3): the inner
+"""hp-mortar BEM for two-body contact with friction (Sections 4.3.3-4.3.5): the inner
 frictionless contact QP solved by Polyak's projected conjugate gradients, the Uzawa
-algorithm for given (Tresca) friction (Algorithm 4.4) and the Dirichlet-to-Neumann
-algorithm (Algorithm 4.3) with damping omega_D, omega_N.
+algorithm for given (Tresca) friction (Algorithm 4.4), the Dirichlet-to-Neumann
+algorithm (Algorithm 4.3) with damping omega_D, omega_N (optionally Aitken-relaxed), the
+global Uzawa algorithm for Coulomb friction (Algorithm 4.5), the indicator eta of
+Section 4.3.5 and the hp-refinement rule of Algorithm 4.6 (:func:`hp_refine`, a
+``refine`` callback for :func:`hpfebe.adaptivity.adapt`).
 
 Discrete setting.  Body i is a :class:`hpfebe.bem.lame.LameBEM` body with unknowns U^i in
 V^i_hp^2 (GLL Lagrange basis, interleaved components) and stiffness S_hat^i; its
@@ -34,8 +37,8 @@ import scipy.linalg as sla
 from ..bem.lame import LameBEM
 from ..coupling.mortar import MortarProjection
 from ..geometry import BoundaryMesh
-from ..nonlinear import SolverInfo, fixed_point
-from ..quadrature import gauss_lobatto
+from ..nonlinear import SingularStep, SolverInfo, fixed_point
+from ..quadrature import gauss_legendre, gauss_lobatto
 
 
 # --------------------------------------------------------------------------- Polyak
@@ -250,11 +253,12 @@ class MortarContact:
         nc = m.dofs1.size
         self.nc = nc
         self.points = self._node_points(bem1, m.dofs1)
-        nrm = self._default_normals(bem1.mesh, m.dofs1, label) if normal is None else \
+        nrm = self._default_normals(bem1.V_space, m.dofs1, label) if normal is None else \
             np.asarray(normal(self.points), dtype=float)
         if nrm.shape != (nc, 2):
             raise ValueError(f"normal must return ({nc}, 2) normals, got {nrm.shape}")
         self.n = nrm / np.linalg.norm(nrm, axis=1)[:, None]
+        self._normal_fn = normal
         self.t = np.column_stack([-self.n[:, 1], self.n[:, 0]])
         self.gap = ray_gap(self.points, self.n, bem2.mesh, label)
         self.w = self._lobatto_weights(bem1.mesh, bem1.V_space, m.dofs1, label)
@@ -294,14 +298,13 @@ class MortarContact:
         return xy[dofs]
 
     @staticmethod
-    def _default_normals(mesh, dofs, label):
-        sp_ = None
-        from ..spaces import ContinuousSpace
-        sp_ = ContinuousSpace(mesh)
-        acc = np.zeros((sp_.ndof, 2))
+    def _default_normals(space, dofs, label):
+        """Sum of the outward normals of the contact elements sharing each node."""
+        mesh = space.mesh
+        acc = np.zeros((space.ndof, 2))
         els = np.flatnonzero(mesh.labels == label)
-        d = sp_.elem_dofs[els]
-        for k in range(d.shape[1]):
+        d = space.elem_dofs[els]
+        for k in range(d.shape[1]):                   # local basis index (<= p + 1)
             ok = d[:, k] >= 0
             np.add.at(acc, d[ok, k], mesh.normals[els[ok]])
         return acc[dofs]
@@ -317,6 +320,15 @@ class MortarContact:
             d = space.elem_dofs[e, :int(p) + 1]
             np.add.at(w, d.ravel(), (0.5 * mesh.lengths[e][:, None] * wg[None, :]).ravel())
         return w[dofs]
+
+    def _normal(self, x) -> np.ndarray:
+        """Unit normal of body 1 at points x of Gamma^1_C (the scene's, or the element's)."""
+        if self._normal_fn is not None:
+            n = np.asarray(self._normal_fn(x), dtype=float)
+        else:
+            e, _ = self.bem1.mesh.locate(x)
+            n = self.bem1.mesh.normals[e]
+        return n / np.linalg.norm(n, axis=1)[:, None]
 
     # ---------------------------------------------------------------- Uzawa step
     @property
@@ -383,7 +395,8 @@ class MortarContact:
     # ---------------------------------------------------------------- DtN
     def dtn(self, omega_D: float, omega_N: float, rho: float = 1.0, tol: float = 1e-6,
             tol_U: float = 1e-6, max_iter: int = 200, max_uzawa: int = 2000,
-            divergence: float = 1e6, rho_relative: bool = True) -> MortarSolution:
+            divergence: float = 1e6, rho_relative: bool = True,
+            aitken: bool = False) -> MortarSolution:
         """Algorithm 4.3 (Dirichlet-to-Neumann) with damping omega_D, omega_N in (0, 1]:
 
         2. S2 U2 = L2 - P_k (Neumann problem of body 2; P_k = the transferred contact
@@ -396,7 +409,12 @@ class MortarContact:
 
         The Uzawa multiplier and the QP solution are warm-started from the previous DtN
         iteration.  Non-convergence (cap, growth, NaN) is reported in ``info.reason``.
-        ``rho_relative``: the Uzawa step is rho * rho_crit / 2 (:meth:`rho_step`)."""
+        ``rho_relative``: the Uzawa step is rho * rho_crit / 2 (:meth:`rho_step`).
+
+        ``aitken`` (beyond the thesis): step 6 with Aitken's dynamic relaxation of the
+        Neumann damping, P_k+1 = P_k + w_k r_k with r_k = B^T D^-T R1 - P_k,
+        w_k = -w_k-1 (r_k-1 . (r_k - r_k-1)) / |r_k - r_k-1|^2 (Irons-Tuck / Kuettler-Wall),
+        w_1 = omega_N; omega_D damping of step 3 as given."""
         _check_omega("omega_D", omega_D)
         _check_omega("omega_N", omega_N)
         rho = self.rho_step(rho, rho_relative)
@@ -407,13 +425,22 @@ class MortarContact:
             u2c = b2.solve(-P[b2.cpos])
             return u2c, b2.expand(u2c)[self.c2]
 
+        st.update(r=None, w=float(omega_N))
+
         def update(P):
             _, u2 = neumann(P)
             Q = (1.0 - omega_D) * st["Q"] + omega_D * m.project(u2)
             x, lam, info = self.uzawa(Q, rho, tol_U, max_uzawa, st["lam"], st["x"])
             st.update(Q=Q, lam=lam, x=x)
             R1 = self.body1.reaction(self.R.T @ x)
-            return (1.0 - omega_N) * P + omega_N * m.adjoint(R1), info
+            r = m.adjoint(R1) - P
+            if aitken and st["r"] is not None:
+                dr = r - st["r"]
+                den = dr @ dr
+                if den > 0:
+                    st["w"] = float(np.clip(-st["w"] * (st["r"] @ dr) / den, 1e-3, 2.0))
+            st["r"] = r
+            return P + (st["w"] if aitken else omega_N) * r, info
 
         P, info = fixed_point(update, np.zeros(self.c2.size), tol, max_iter, norm=2,
                               divergence=divergence)
@@ -440,7 +467,7 @@ class MortarContact:
             sw = np.sqrt(Wk)
             G = sw[:, None] * H * sw[None, :]
             lam_max = np.linalg.eigvalsh(0.5 * (G + G.T))[-1]
-            self._glob = dict(Wk=Wk, T2=T2, rho_crit=2.0 / lam_max, nc=nc)
+            self._glob = dict(Wk=Wk, T2=T2, rho_crit=2.0 / lam_max, nc=nc, H=H, Pi=Pi)
         return self._glob
 
     def global_uzawa(self, rho: float = 1.0, tol: float = 1e-6, max_iter: int = 20000,
@@ -487,14 +514,89 @@ class MortarContact:
 
         P, info = fixed_point(update, np.zeros(2 * nc), tol, max_iter, norm=2,
                               divergence=divergence, min_iter=3)
-        u1, u2c = bodies(P)
+        info.counts = dict(rho=step, rho_crit=g["rho_crit"])
+        return self._state(P, info, friction, mu_f)
+
+    def _state(self, P, info, friction, mu_f) -> MortarSolution:
+        """Displacements of the nodal contact traction P (the two Neumann problems)."""
+        g = self._global_operators()
+        b1, b2, nc = self.body1, self.body2, self.nc
+        u1 = b1.solve(-g["Wk"] * P)
+        u2c = b2.solve(g["T2"] @ (g["Wk"] * P))
         Q = self.mortar.project(b2.expand(u2c)[self.c2])
         pn, pt = self.frame(P)
         bound = mu_f * pn if friction == "coulomb" else np.full(nc, self.F)
         lam = np.divide(pt, bound, out=np.zeros(nc), where=bound > 0)
-        info.counts = dict(rho=step, rho_crit=g["rho_crit"])
         return MortarSolution(b1.expand(u1), b2.expand(u2c), lam, Q, P,
                               self.R @ u1, info, extra=dict(pn=pn, pt=pt))
+
+    # ---------------------------------------------------------------- semismooth Newton
+    def semismooth_newton(self, tol: float = 1e-10, max_iter: int = 100,
+                          friction: str = "coulomb", mu_f: float = 0.1) -> MortarSolution:
+        """Monolithic semismooth Newton (primal-dual active set) for the discrete problem
+        of Algorithm 4.5 (beyond the thesis).  The displacements are linear in the nodal
+        traction P, d(P) = U1 - pi U2 = d0 - H Wk P (:meth:`_global_operators`); in the
+        node frames y = (P_n, P_t) it solves the complementarity functions
+
+            P_n - max(0, z_n) = 0,   P_t - clip(z_t, -b, b) = 0,
+            z_n = P_n + c (d_n - g),  z_t = P_t + c d_t,  b = mu_f max(0, z_n) or F,
+
+        with c = rho_crit / 2, by :func:`hpfebe.nonlinear.newton` (line search on
+        1/2 |F|^2, cycling detection on the active/stick pattern)."""
+        from ..nonlinear import Iterate, newton
+
+        if friction not in ("coulomb", "tresca"):
+            raise ValueError(f"friction must be 'coulomb' or 'tresca', got {friction!r}")
+        if not (np.isfinite(mu_f) and mu_f >= 0):
+            raise ValueError(f"mu_f must be >= 0, got {mu_f!r}")
+        g = self._global_operators()
+        nc, R = self.nc, self.R
+        c = 0.5 * g["rho_crit"]
+        b1, b2 = self.body1, self.body2
+        d0 = R @ (b1.solve(np.zeros(2 * nc)) - g["Pi"] @ b2.solve(np.zeros(b2.cpos.size)))
+        G = R @ (g["H"] * g["Wk"][None, :]) @ R.T          # d(local) = d0 - G y
+        closed = np.isfinite(self.gap)
+        gap = np.where(closed, self.gap, 0.0)
+        eye = np.eye(2 * nc)
+        scale = max(float(np.abs(c * d0).max()), 1e-300)
+
+        class Problem:
+            def evaluate(_, y):
+                d = d0 - G @ y
+                zn = np.where(closed, y[:nc] + c * (d[:nc] - gap), -1.0)
+                zt = y[nc:] + c * d[nc:]
+                bnd = mu_f * np.maximum(0.0, zn) if friction == "coulomb" else \
+                    np.full(nc, self.F)
+                Fr = np.concatenate([y[:nc] - np.maximum(0.0, zn),
+                                     y[nc:] - np.clip(zt, -bnd, bnd)])
+                act, stick = zn > 0, np.abs(zt) < bnd
+                return Iterate(y, Fr, 0.5 * float(Fr @ Fr), scale,
+                               key=(act.tobytes(), stick.tobytes()),
+                               data=(act, stick, np.sign(zt)))
+
+            def step(_, it):
+                act, stick, sg = it.data
+                J = eye.copy()
+                rows_n = np.flatnonzero(act)
+                J[rows_n] = c * G[rows_n]
+                rows_t = nc + np.flatnonzero(stick)
+                J[rows_t] = c * G[rows_t]
+                if friction == "coulomb":
+                    slip = np.flatnonzero(~stick & act)
+                    # d b / d y = mu_f (e_n - c G[n, :]) on slipping, active nodes
+                    J[nc + slip] -= (sg[slip] * mu_f)[:, None] * (eye[slip] - c * G[slip])
+                try:
+                    return np.linalg.solve(J, -it.residual)
+                except np.linalg.LinAlgError as e:
+                    raise SingularStep(f"singular Newton matrix: {e}") from None
+
+            def slope(_, it, dx):
+                return -2.0 * it.merit
+
+        it, info = newton(Problem(), np.zeros(2 * nc), tol, max_iter, norm=2)
+        P = R.T @ it.x
+        info.counts = dict(c=c)
+        return self._state(P, info, friction, mu_f)
 
     # ---------------------------------------------------------------- post-processing
     def norm_W(self, U1, U2) -> float:
@@ -516,18 +618,10 @@ class MortarContact:
 
 
 # --------------------------------------------------------------------------- scene
-def model_problem(n1: int = 16, n2: int = 12, p1: int = 2, p2: int = 2,
-                  E: float = 266926.0, nu: float = 0.29, F: float = 0.1,
-                  u_top=(0.0, -0.09), radius: float = 5.05, plane: str = "strain",
-                  L: float = 2.0) -> MortarContact:
-    """The model problem of Section 4.3.4 (thesis lines 19474-19530): body 1 bounded by
-    Gamma^1_D = [-1,1] x {2} (U = u_top), Gamma^1_N = {-1,1} x [0.1, 2] and the arc
-    Gamma^1_C of radius ``radius`` through (-1, 0.1), (0, 0), (1, 0.1); body 2 =
-    [-1,1] x [-2,0] with Gamma^2_C = [-1,1] x {0} and Gamma^2_D = the rest (U = 0).
-    Meshes: ``n1`` elements on Gamma^1_C (h1 = L / n1, equal angles), ``n2`` on
-    Gamma^2_C (h2 = L / n2), the other sides with ceil(length / h) elements; degrees
-    p1, p2 everywhere.  Normals of Gamma^1_C: the radial direction of the circle; gap
-    along it."""
+def model_meshes(n1: int = 16, n2: int = 12, p1: int = 2, p2: int = 2,
+                 radius: float = 5.05, L: float = 2.0):
+    """Boundary meshes of the model problem of Section 4.3.4 (see :func:`model_problem`)
+    and the radial normal of the arc: (mesh1, mesh2, normal)."""
     for name, v in (("n1", n1), ("n2", n2), ("p1", p1), ("p2", p2)):
         if int(v) != v or v < 1:
             raise ValueError(f"{name} must be a positive integer, got {v!r}")
@@ -547,10 +641,123 @@ def model_problem(n1: int = 16, n2: int = 12, p1: int = 2, p2: int = 2,
     k2 = int(np.ceil(2.0 / h2 - 1e-9))
     mesh2 = BoundaryMesh.polygon([(-1, -2), (1, -2), (1, 0), (-1, 0)], n=[k2, k2, int(n2), k2],
                                  labels=["D", "D", "C", "D"], p=int(p2))
-    bem1, bem2 = LameBEM(mesh1, E, nu, plane), LameBEM(mesh2, E, nu, plane)
 
     def normal(x):
-        d = x - np.array([0.0, yc])
+        d = np.asarray(x, dtype=float) - np.array([0.0, yc])
         return d / np.linalg.norm(d, axis=1)[:, None]
 
+    return mesh1, mesh2, normal
+
+
+def contact_from_meshes(mesh1, mesh2, normal, E: float = 266926.0, nu: float = 0.29,
+                        F: float = 0.1, u_top=(0.0, -0.09),
+                        plane: str = "strain") -> MortarContact:
+    """The model problem's boundary conditions on given meshes (e.g. adaptive ones)."""
+    bem1, bem2 = LameBEM(mesh1, E, nu, plane), LameBEM(mesh2, E, nu, plane)
     return MortarContact(bem1, bem2, ("D", u_top), ("D", (0.0, 0.0)), F, normal=normal)
+
+
+def model_problem(n1: int = 16, n2: int = 12, p1: int = 2, p2: int = 2,
+                  E: float = 266926.0, nu: float = 0.29, F: float = 0.1,
+                  u_top=(0.0, -0.09), radius: float = 5.05, plane: str = "strain",
+                  L: float = 2.0) -> MortarContact:
+    """The model problem of Section 4.3.4 (thesis lines 19474-19530): body 1 bounded by
+    Gamma^1_D = [-1,1] x {2} (U = u_top), Gamma^1_N = {-1,1} x [0.1, 2] and the arc
+    Gamma^1_C of radius ``radius`` through (-1, 0.1), (0, 0), (1, 0.1); body 2 =
+    [-1,1] x [-2,0] with Gamma^2_C = [-1,1] x {0} and Gamma^2_D = the rest (U = 0).
+    Meshes: ``n1`` elements on Gamma^1_C (h1 = L / n1, equal angles), ``n2`` on
+    Gamma^2_C (h2 = L / n2), the other sides with ceil(length / h) elements; degrees
+    p1, p2 everywhere.  Normals of Gamma^1_C: the radial direction of the circle; gap
+    along it."""
+    if not np.isfinite(F) or F < 0:
+        raise ValueError(f"F must be >= 0, got {F!r}")
+    mesh1, mesh2, normal = model_meshes(n1, n2, p1, p2, radius, L)
+    return contact_from_meshes(mesh1, mesh2, normal, E, nu, F, u_top, plane)
+
+
+# --------------------------------------------------------------------------- hp
+def mortar_indicators(pr: MortarContact, sol: MortarSolution, nq: int | None = None,
+                      return_parts: bool = False):
+    """The indicator eta = (eta_C^2 + eta_N^2 + eta_S^2)^(1/2) of Section 4.3.5, one
+    value per element of each mesh: (eta1, eta2).
+
+    With the nodal contact traction P of the solution (force on body 1 = -P, on body 2
+    = +P at the paired point) as the datum on Gamma_C and t_hat = 0 on Gamma_N:
+
+    * eta_N^2 + third term of eta_C^2: (h_I / p_I) ||datum - S_hat U||^2_{L2(I)},
+    * eta_S^2: (h_I / p_I) h_I ||d/ds (V Psi - (K + 1/2) U)||^2_{L2(I)} (the derivative
+      form of :func:`hpfebe.adaptivity.bem_estimator.lame_bem_indicators`, Section 3.3.3,
+      instead of the L2 norm of the residual itself),
+    * on Gamma^1_C also (h_I / p_I) ||[P]||^2 + (h_I / p_I)^-1 ||[U_n]_+||^2 with
+      [P] = Psi^1 + Psi^2 (paired point; zero for equal and opposite tractions) and
+      [U_n]_+ = max(0, (U^1 - U^2) . n - g) (paired point, gap along n).
+    """
+    from ..adaptivity.bem_estimator import lame_bem_indicators
+
+    m = pr.mortar
+    b1, b2 = pr.bem1, pr.bem2
+    P = np.zeros((b1.V_space.ndof, 2))
+    P[m.dofs1] = sol.P.reshape(-1, 2)
+    zero = lambda x, n: np.zeros((len(x), 2))  # noqa: E731
+
+    def datum1(x, n, elem, t):
+        return -b1.V_space.evaluate(P, elem, t)
+
+    def datum2(x, n, elem, t):
+        e1, t1, inside = m.locate(m.parameter(x), 1)
+        out = np.zeros((len(x), 2))
+        if inside.any():
+            out[inside] = b1.V_space.evaluate(P, e1[inside], t1[inside])
+        return out
+
+    U1, U2 = sol.U1, sol.U2
+    Psi1, Psi2 = b1.Psi(U1), b2.Psi(U2)
+    eta1, parts1 = lame_bem_indicators(b1, U1, Psi1, {"N": zero, "C": datum1}, nq,
+                                       return_parts=True)
+    eta2, parts2 = lame_bem_indicators(b2, U2, Psi2, {"C": datum2}, nq, return_parts=True)
+    eta1 = eta1 ** 2 / b1.mesh.degrees
+    eta2 = eta2 ** 2 / b2.mesh.degrees
+    # jump terms on Gamma^1_C
+    mesh = b1.mesh
+    els = np.flatnonzero(mesh.labels == "C")
+    q = int(mesh.degrees.max()) + 3 if nq is None else int(nq)
+    tq, wq = (np.asarray(v, float) for v in gauss_legendre(q))
+    elem = np.repeat(els, q)
+    t = np.tile(tq, els.size)
+    w = np.tile(wq, els.size) * mesh.lengths[elem] / 2.0
+    x = mesh.points(elem, t)
+    e2, t2, inside = m.locate(m.parameter(x), 2)
+    u1 = b1.V_space.evaluate(U1.reshape(-1, 2), elem, t)
+    ps1 = b1.W_space.evaluate(Psi1.reshape(-1, 2), elem, t)
+    u2, ps2 = np.zeros_like(u1), np.zeros_like(u1)
+    u2[inside] = b2.V_space.evaluate(U2.reshape(-1, 2), e2[inside], t2[inside])
+    ps2[inside] = b2.W_space.evaluate(Psi2.reshape(-1, 2), e2[inside], t2[inside])
+    nrm = pr._normal(x)
+    g = ray_gap(x, nrm, b2.mesh, "C")
+    pen = np.where(inside & np.isfinite(g), np.maximum(0.0, np.sum((u1 - u2) * nrm, 1) - g), 0.0)
+    jump = np.sum((ps1 + ps2) ** 2, 1)
+    hp = mesh.lengths / mesh.degrees
+    jP = hp * np.bincount(elem, w * jump, minlength=mesh.n_elements)
+    jU = np.bincount(elem, w * pen ** 2, minlength=mesh.n_elements) / hp
+    eta1 = np.sqrt(eta1 + jP + jU)
+    eta2 = np.sqrt(eta2)
+    if return_parts:
+        return (eta1, eta2), dict(jump_P=np.sqrt(jP), penetration=np.sqrt(jU),
+                                  residual1=parts1, residual2=parts2)
+    return eta1, eta2
+
+
+def hp_refine(mesh: BoundaryMesh, marked, eta, h_fraction: float = 0.9) -> BoundaryMesh:
+    """Algorithm 4.6 on the marked elements (marked: eta_I >= q1 eta_max): h-refine
+    (bisect) where eta_I >= ``h_fraction`` eta_max, raise p by one on the others."""
+    marked = np.asarray(marked, dtype=bool)
+    eta = np.asarray(eta, dtype=float)
+    if eta.shape != marked.shape or marked.shape != (mesh.n_elements,):
+        raise ValueError(f"marked and eta must have one entry per element "
+                         f"({mesh.n_elements}), got {marked.shape}, {eta.shape}")
+    if not 0 < h_fraction <= 1:
+        raise ValueError(f"h_fraction must lie in (0, 1], got {h_fraction!r}")
+    h = marked & (eta >= h_fraction * eta.max())
+    p = marked & ~h
+    out = mesh.raise_degree(p) if p.any() else mesh
+    return out.refine(h) if h.any() else out

@@ -98,9 +98,19 @@ class NitscheFEBE:
             raise ValueError(f"problem must be an InterfaceProblem, got {problem!r}")
         if not np.isfinite(alpha):
             raise ValueError(f"alpha must be a finite number, got {alpha!r}")
+        for name, p in (("p_fe", p_fe), ("p_be", p_be)):
+            if p is None and name == "p_be":
+                continue
+            if (isinstance(p, (bool, np.bool_))
+                    or not isinstance(p, (int, float, np.integer, np.floating))
+                    or not np.isfinite(p) or p != int(p) or p < 1):
+                raise ValueError(f"{name} must be an integer >= 1, got {p!r}")
         p_be = p_fe if p_be is None else p_be
-        if int(p_be) != p_be or p_be < 1:
-            raise ValueError(f"p_be must be an integer >= 1, got {p_be!r}")
+        for name, h in (("fe_h_inv", fe_h_inv), ("be_h_inv", be_h_inv)):
+            if isinstance(h, (bool, np.bool_)) or not (
+                    isinstance(h, (int, float, np.integer, np.floating))
+                    and np.isfinite(h) and h > 0):
+                raise ValueError(f"{name} must be a positive number, got {h!r}")
         self.problem, self.alpha, self.h_def = problem, float(alpha), h_def
         self.p_fe, self.p_be = int(p_fe), int(p_be)
         self.fe_h_inv, self.be_h_inv = float(fe_h_inv), float(be_h_inv)

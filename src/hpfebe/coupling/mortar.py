@@ -1,0 +1,179 @@
+"""Mortar projection between two non-matching contact meshes (Section 4.3.3, (4.50),
+(4.87)).
+
+For a function Phi^2 in X^2_hp (traces of V^2_hp on Gamma^2_C) its mortar projection
+Phi^1 = pi^1_hp Phi^2 in X^1_hp (traces of V^1_hp on Gamma^1_C = the mortar space M^1_hp)
+is defined by (4.87)
+
+    int_{Gamma_C} Phi^1 Psi^1 ds = int_{Gamma_C} Phi^2 Psi^1 ds    for all Psi^1 in M^1_hp,
+
+algebraically Phi^1 = D^-1 B Phi^2 with the mass matrix D of M^1_hp and the mixed mass
+matrix B; tractions (functionals on X^1_hp) are transferred by the adjoint
+pi^1*_hp R = B^T D^-T R.
+
+The two contact boundaries are different curves (body 1's arc and body 2's straight
+side, with a gap between them); a point of Gamma^1_C is paired with the point of
+Gamma^2_C having the same parameter s = x . ``axis`` (default: the x-coordinate, i.e. the
+projection along the normal of a horizontal Gamma^2_C).  Both contact zones must be
+graphs over s.  Gamma_C in (4.87) is Gamma^1_C with its arc length ds: the integrals are
+taken on the common refinement of the two meshes in s (all element end points of both
+zones), on every piece by Gauss-Legendre with max(p1, p2) + 1 points, which is exact:
+on a piece both element maps are affine in s, ds/d s is constant, so the
+integrand is a polynomial of degree p1 + p2 <= 2 max(p1, p2) in s.  (The closed-curve
+:func:`hpfebe.geometry.common_refinement` does not fit: the two zones are open pieces of
+two different boundaries; the refinement here is the merge of their break points in s.)
+
+Scalar dofs: ``dofs1`` / ``dofs2``, the dofs of the two :class:`ContinuousSpace` whose
+basis functions do not vanish on the contact elements (closure, end points included).
+Vector fields are interleaved (2 d + c) and transferred component by component.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+
+from ..geometry import BoundaryMesh
+from ..quadrature import gauss_legendre
+from ..spaces import ContinuousSpace
+
+
+def _zone(mesh: BoundaryMesh, label: str, axis: np.ndarray, name: str):
+    if not isinstance(mesh, BoundaryMesh):
+        raise ValueError(f"{name} must be a BoundaryMesh, got {type(mesh).__name__}")
+    els = np.flatnonzero(mesh.labels == label)
+    if els.size == 0:
+        raise ValueError(f"label{name[-1]}: mesh {name} has no element labelled {label!r}, "
+                         "the mortar space has no support")
+    sa, sb = mesh.a[els] @ axis, mesh.b[els] @ axis
+    if np.any(np.abs(sb - sa) <= 1e-12 * mesh.scale):
+        raise ValueError(f"{name}: the contact zone {label!r} is not a graph over the axis "
+                         "(an element is perpendicular to it)")
+    lo, hi = np.minimum(sa, sb), np.maximum(sa, sb)
+    order = np.argsort(lo)
+    if np.any(lo[order][1:] < hi[order][:-1] - 1e-12 * mesh.scale):
+        raise ValueError(f"{name}: the contact zone {label!r} is not a graph over the axis "
+                         "(elements overlap in the parameter)")
+    return els, sa, sb, lo, hi
+
+
+class MortarProjection:
+    """Mortar projection pi^1_hp: X^2_hp -> X^1_hp (4.87) and its adjoint.
+
+    Parameters
+    ----------
+    mesh1, mesh2 : BoundaryMesh of body 1 (mortar side) and body 2
+    label1, label2 : contact labels of the two meshes
+    axis : unit vector; the parameter s = x . axis pairs the points of the two zones
+    space1, space2 : the ContinuousSpace of each mesh (default: built on the mesh)
+
+    Attributes: ``dofs1``, ``dofs2`` (scalar contact dofs), ``D`` (n1 x n1), ``B``
+    (n1 x n2), sparse; ``overlap`` = (s_min, s_max) of the common part.
+    """
+
+    def __init__(self, mesh1: BoundaryMesh, mesh2: BoundaryMesh, label1: str = "C",
+                 label2: str = "C", axis=(1.0, 0.0), space1: ContinuousSpace | None = None,
+                 space2: ContinuousSpace | None = None):
+        axis = np.asarray(axis, dtype=float)
+        if axis.shape != (2,) or not np.isfinite(axis).all() or np.linalg.norm(axis) == 0:
+            raise ValueError(f"axis must be a nonzero 2-vector, got {axis!r}")
+        axis = axis / np.linalg.norm(axis)
+        self.axis = axis
+        self.space1 = space1 if space1 is not None else ContinuousSpace(mesh1)
+        self.space2 = space2 if space2 is not None else ContinuousSpace(mesh2)
+        for k, (sp_, m) in enumerate(((self.space1, mesh1), (self.space2, mesh2)), 1):
+            if sp_.mesh is not m:
+                raise ValueError(f"space{k} must be built on mesh{k}")
+        e1, sa1, sb1, lo1, hi1 = _zone(mesh1, label1, axis, "mesh1")
+        e2, sa2, sb2, lo2, hi2 = _zone(mesh2, label2, axis, "mesh2")
+        s_min, s_max = max(lo1.min(), lo2.min()), min(hi1.max(), hi2.max())
+        tol = 1e-12 * max(mesh1.scale, mesh2.scale)
+        if s_max <= s_min + tol:
+            raise ValueError(f"mesh2: the contact zones do not overlap (mesh1 on "
+                             f"[{lo1.min():.6g}, {hi1.max():.6g}], mesh2 on "
+                             f"[{lo2.min():.6g}, {hi2.max():.6g}] along the axis)")
+        self.overlap = (float(s_min), float(s_max))
+        self.mesh1, self.mesh2 = mesh1, mesh2
+        self.dofs1 = self.space1.dofs_on(label1)
+        self.dofs2 = self.space2.dofs_on(label2)
+        p1 = int(mesh1.degrees[e1].max())
+        p2 = int(mesh2.degrees[e2].max())
+        nq = max(p1, p2) + 1          # exact for D (degree 2 p1) and B (p1 + p2)
+        tq, wq = (np.asarray(v, float) for v in gauss_legendre(nq))
+        # D: on the elements of zone 1 (mass matrix of M^1_hp)
+        t = np.broadcast_to(tq, (e1.size, nq))
+        P1 = self.space1.trace_matrix(np.repeat(e1, nq), t.ravel())
+        w = (0.5 * mesh1.lengths[e1])[:, None] * wq[None, :]
+        D = P1.T @ sp.diags(w.ravel()) @ P1
+        self.D = sp.csr_matrix(D[self.dofs1][:, self.dofs1])
+        # B: on the common refinement of both zones in s, restricted to the overlap
+        brk = np.unique(np.concatenate([lo1, hi1, lo2, hi2]))
+        brk = brk[(brk >= s_min - tol) & (brk <= s_max + tol)]
+        brk = np.clip(brk, s_min, s_max)
+        keep = np.concatenate([[True], np.diff(brk) > tol])
+        brk = brk[keep]
+        a, b = brk[:-1], brk[1:]
+        mid = 0.5 * (a + b)
+        k1 = self._owner(mid, lo1, hi1, "mesh1")
+        k2 = self._owner(mid, lo2, hi2, "mesh2")
+        s = (0.5 * (a + b))[:, None] + (0.5 * (b - a))[:, None] * tq[None, :]   # (npc, nq)
+        t1 = 2.0 * (s - sa1[k1][:, None]) / (sb1 - sa1)[k1][:, None] - 1.0
+        t2 = 2.0 * (s - sa2[k2][:, None]) / (sb2 - sa2)[k2][:, None] - 1.0
+        jac = mesh1.lengths[e1[k1]] / np.abs(sb1 - sa1)[k1]                   # ds / d s
+        wB = (0.5 * (b - a) * jac)[:, None] * wq[None, :]
+        Q1 = self.space1.trace_matrix(np.repeat(e1[k1], nq), np.clip(t1, -1, 1).ravel())
+        Q2 = self.space2.trace_matrix(np.repeat(e2[k2], nq), np.clip(t2, -1, 1).ravel())
+        B = Q1.T @ sp.diags(wB.ravel()) @ Q2
+        self.B = sp.csr_matrix(B[self.dofs1][:, self.dofs2])
+        self._lu = spla.splu(sp.csc_matrix(self.D))
+        self.pieces = np.column_stack([a, b])
+        self._zones = ((e1, sa1, sb1, lo1, hi1), (e2, sa2, sb2, lo2, hi2))
+
+    def parameter(self, points) -> np.ndarray:
+        """The pairing parameter s = x . axis of points."""
+        return np.asarray(points, dtype=float) @ self.axis
+
+    def locate(self, s, side: int):
+        """(elem, t, inside) of the points with parameter ``s`` on the contact zone of
+        mesh ``side`` (1 or 2); ``inside`` False (elem -1) outside the zone."""
+        if side not in (1, 2):
+            raise ValueError(f"side must be 1 or 2, got {side!r}")
+        e, sa, sb, lo, hi = self._zones[side - 1]
+        s = np.atleast_1d(np.asarray(s, dtype=float))
+        order = np.argsort(lo)
+        k = order[np.clip(np.searchsorted(lo[order], s, side="right") - 1, 0, len(lo) - 1)]
+        tol = 1e-12 * (hi.max() - lo.min())
+        inside = (s >= lo[k] - tol) & (s <= hi[k] + tol)
+        t = np.clip(2.0 * (s - sa[k]) / (sb[k] - sa[k]) - 1.0, -1.0, 1.0)
+        return np.where(inside, e[k], -1), np.where(inside, t, np.nan), inside
+
+    @staticmethod
+    def _owner(s, lo, hi, name):
+        order = np.argsort(lo)
+        k = np.searchsorted(lo[order], s, side="right") - 1
+        k = order[np.clip(k, 0, len(lo) - 1)]
+        if np.any((s < lo[k]) | (s > hi[k])):
+            raise ValueError(f"{name}: the contact zone has a hole inside the overlap")
+        return k
+
+    # ------------------------------------------------------------------ transfer
+    def _apply(self, v, n_in, op):
+        v = np.asarray(v, dtype=float)
+        if v.ndim != 1 or v.size not in (n_in, 2 * n_in):
+            raise ValueError(f"vector must have {n_in} (scalar) or {2 * n_in} (interleaved "
+                             f"2-component) entries, got shape {v.shape}")
+        comps = v.size // n_in
+        out = op(v.reshape(n_in, comps))
+        return np.asarray(out).ravel()
+
+    def project(self, phi2) -> np.ndarray:
+        """pi^1_hp Phi^2 = D^-1 B Phi^2 (coefficients on ``dofs1``) of Phi^2 given by its
+        coefficients on ``dofs2`` (scalar, or interleaved vector)."""
+        return self._apply(phi2, self.dofs2.size, lambda V: self._lu.solve(self.B @ V))
+
+    def adjoint(self, r1) -> np.ndarray:
+        """pi^1*_hp R = B^T D^-T R of a functional R on X^1_hp (values on ``dofs1``),
+        a functional on X^2_hp (values on ``dofs2``)."""
+        return self._apply(r1, self.dofs1.size,
+                           lambda V: self.B.T @ self._lu.solve(V, trans="T"))

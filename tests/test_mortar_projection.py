@@ -1,0 +1,107 @@
+"""Mortar projection (4.87) and Polyak's projected CG (Section 4.3.3)."""
+
+import numpy as np
+import pytest
+import scipy.linalg as sla
+from scipy.optimize import lsq_linear
+
+from hpfebe.contact.mortar import projected_cg
+from hpfebe.coupling.mortar import MortarProjection
+from hpfebe.geometry import BoundaryMesh
+from hpfebe.spaces import ContinuousSpace
+
+
+def _arc_mesh(n, p, radius=5.05):
+    half = np.arcsin(1.0 / radius)
+    ang = np.linspace(-half, half, n + 1)
+    arc = np.column_stack([radius * np.sin(ang), radius - radius * np.cos(ang)])
+    verts = np.vstack([arc, [[1.0, 2.0], [-1.0, 2.0]]])
+    return BoundaryMesh.polygon(verts, n=[1] * n + [3, 4, 3], labels=["C"] * n + ["N", "D", "N"],
+                                p=p)
+
+
+def _box_mesh(n, p, x0=-1.0, x1=1.0):
+    return BoundaryMesh.polygon([(x0, -2), (x1, -2), (x1, 0), (x0, 0)], n=[3, 3, n, 3],
+                                labels=["D", "D", "C", "D"], p=p)
+
+
+@pytest.mark.parametrize("p1,p2,n1,n2", [(1, 1, 7, 5), (2, 1, 16, 12), (2, 2, 16, 12),
+                                         (3, 2, 5, 9), (4, 3, 6, 4)])
+def test_reproduces_polynomials(p1, p2, n1, n2):
+    """Polynomials in x of degree <= min(p1, p2) are reproduced on non-matching meshes
+    (arc polygon vs straight line, paired by the x-coordinate)."""
+    m = MortarProjection(_arc_mesh(n1, p1), _box_mesh(n2, p2))
+    s1, s2 = m.space1, m.space2
+    for deg in range(min(p1, p2) + 1):
+        coef = np.arange(1, deg + 2) * (-0.7) ** np.arange(deg + 1)
+        f = lambda x: np.polyval(coef, x[:, 0])  # noqa: E731
+        phi2 = s2.interpolate(f)[m.dofs2]
+        phi1 = s1.interpolate(f)[m.dofs1]
+        assert np.max(np.abs(m.project(phi2) - phi1)) < 1e-12 * max(1, np.abs(phi1).max())
+    # vector (interleaved) version: component by component
+    v2 = np.column_stack([np.ones(m.dofs2.size), 2 * np.ones(m.dofs2.size)]).ravel()
+    assert np.allclose(m.project(v2).reshape(-1, 2), [1.0, 2.0], atol=1e-13)
+
+
+def test_defining_identity_and_adjoint():
+    m = MortarProjection(_arc_mesh(9, 2), _box_mesh(7, 3))
+    rng = np.random.default_rng(0)
+    phi2 = rng.standard_normal(m.dofs2.size)
+    psi1 = rng.standard_normal(m.dofs1.size)
+    # (4.87): int pi(Phi2) Psi1 = int Phi2 Psi1 for all Psi1 in M^1
+    assert abs(psi1 @ (m.D @ m.project(phi2)) - psi1 @ (m.B @ phi2)) < 1e-12 * np.abs(
+        m.B).sum()
+    # adjoint identity <pi Phi2, R1> = <Phi2, pi* R1> (coefficients x functional values)
+    r1 = rng.standard_normal(m.dofs1.size)
+    lhs, rhs = m.project(phi2) @ r1, phi2 @ m.adjoint(r1)
+    assert abs(lhs - rhs) <= 1e-12 * max(1.0, abs(lhs))
+    v2, w1 = rng.standard_normal(2 * m.dofs2.size), rng.standard_normal(2 * m.dofs1.size)
+    assert abs(m.project(v2) @ w1 - v2 @ m.adjoint(w1)) <= 1e-12 * max(1, abs(v2 @ m.adjoint(w1)))
+    # D is the mass matrix of the arc polygon: total length
+    one = np.ones(m.dofs1.size)
+    assert one @ (m.D @ one) == pytest.approx(np.sum(m.mesh1.lengths[m.mesh1.labels == "C"]),
+                                              rel=1e-13)
+
+
+def test_bad_input():
+    a, b = _arc_mesh(4, 1), _box_mesh(3, 1)
+    with pytest.raises(ValueError, match="overlap"):
+        MortarProjection(a, _box_mesh(3, 1, 3.0, 5.0))
+    with pytest.raises(ValueError, match="label1"):
+        MortarProjection(a, b, label1="X")
+    with pytest.raises(ValueError, match="axis"):
+        MortarProjection(a, b, axis=(0.0, 0.0))
+    with pytest.raises(ValueError, match="space2"):
+        MortarProjection(a, b, space2=ContinuousSpace(a))
+    m = MortarProjection(a, b)
+    with pytest.raises(ValueError, match="entries"):
+        m.project(np.ones(m.dofs2.size + 1))
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_projected_cg_kkt_against_scipy(seed):
+    rng = np.random.default_rng(seed)
+    n = int(rng.integers(5, 40))
+    M = rng.standard_normal((n, n))
+    A = M @ M.T + 0.5 * np.eye(n)
+    b = rng.standard_normal(n) * 3
+    u = rng.standard_normal(n)
+    u[rng.random(n) < 0.3] = np.inf
+    x, info = projected_cg(A, b, u, tol=1e-12)
+    assert info.converged, info.reason
+    g = A @ x - b
+    assert np.all(x <= u + 1e-14)
+    at = x >= u
+    assert np.all(g[at] <= 1e-9 * np.linalg.norm(b))            # multipliers >= 0
+    assert np.linalg.norm(g[~at]) <= 1e-9 * np.linalg.norm(b)   # stationary on the free set
+    L = sla.cholesky(A, lower=True)
+    ref = lsq_linear(L.T, sla.solve_triangular(L, b, lower=True), bounds=(-np.inf, u),
+                     tol=1e-14, lsmr_tol="auto", max_iter=10000).x
+    assert np.linalg.norm(x - ref) <= 1e-6 * max(1.0, np.linalg.norm(ref))
+
+
+def test_projected_cg_bad_input():
+    with pytest.raises(ValueError, match="tol"):
+        projected_cg(np.eye(2), np.ones(2), np.ones(2), tol=0.0)
+    with pytest.raises(ValueError, match="upper"):
+        projected_cg(np.eye(2), np.ones(2), np.ones(3))
