@@ -286,6 +286,25 @@ def lame_body(bem, name: str = "bem"):
     return bem
 
 
+def against_obstacle(bem, S, contact_label: str, dirichlet_label: str, load):
+    """The one-body problems of Sections 3.2-3.3: (BEBody, its Dirichlet dofs or None,
+    the load vector or None), checked."""
+    lame_body(bem)
+    if not np.any(bem.mesh.where(contact_label)):
+        raise ValueError(f"contact_label {contact_label!r}: no element carries this label")
+    body = BEBody(bem, S)
+    fixed = body.dofs_on(dirichlet_label) if np.any(bem.mesh.where(dirichlet_label)) \
+        else None
+    f = None
+    if load is not None:
+        f = np.asarray(load, dtype=float)
+        if f.shape != (body.ndofs,):
+            raise ValueError(f"load must have {body.ndofs} entries, got {f.shape}")
+        if not np.all(np.isfinite(f)):
+            raise ValueError("load must be finite (NaN or inf entries)")
+    return body, fixed, f
+
+
 def as_body(body, name: str = "body"):
     """The contact body of an :class:`ElasticBody` (FE), a :class:`LameBEM` (BE), or a
     body object already (FEBody, BEBody, RigidObstacle or any object with ``kind``)."""

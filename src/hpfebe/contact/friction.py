@@ -32,7 +32,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .bodies import BEBody, RigidObstacle, lame_body
+from .bodies import RigidObstacle, against_obstacle
 from .laws import OPEN, SLIP, STATE_NAMES, STICK  # noqa: F401  (re-exported)
 from .laws import positive
 from .two_body import ContactResult, TwoBodyContact
@@ -86,7 +86,6 @@ def solve_friction(bem, eps_n: float, eps_t: float, gap, friction: str = "tresca
     initial : a converged result of the same body, law and points to continue from
         (U, slip, load and obstacle motion ramped from its final values)
     """
-    lame_body(bem)
     eps_n = positive("eps_n", eps_n)
     eps_t = positive("eps_t", eps_t)
     law, bound = _law(friction, F, mu_f)
@@ -95,20 +94,9 @@ def solve_friction(bem, eps_n: float, eps_t: float, gap, friction: str = "tresca
     tol = positive("tol", tol)
     if nq is not None:
         nq = _count("nq", nq)
-    if not np.any(bem.mesh.where(contact_label)):
-        raise ValueError(f"contact_label {contact_label!r}: no element carries this label")
-    body = BEBody(bem, S)
+    body, fixed, f = against_obstacle(bem, S, contact_label, dirichlet_label, load)
     pr = TwoBodyContact(body, RigidObstacle(gap, obstacle_slip), contact_label,
                         eps_n=eps_n, eps_t=eps_t, nq=nq, **bound)
-    fixed = body.dofs_on(dirichlet_label) if np.any(bem.mesh.where(dirichlet_label)) \
-        else None
-    f = None
-    if load is not None:
-        f = np.asarray(load, dtype=float)
-        if f.shape != (pr.ndofs,):
-            raise ValueError(f"load must have {pr.ndofs} entries, got {f.shape}")
-        if not np.all(np.isfinite(f)):
-            raise ValueError("load must be finite (NaN or inf entries)")
     return pr.solve(f, fixed, None, np.arange(1, load_steps + 1) / load_steps, rtol=tol,
                     max_iter=max_iter, line_search=True, norm="max",
                     merit="energy" if law == "tresca" else "residual",

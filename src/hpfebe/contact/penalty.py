@@ -33,7 +33,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..nonlinear import SolverInfo
-from .bodies import BEBody, RigidObstacle, lame_body
+from .bodies import BEBody, RigidObstacle, against_obstacle
 from .laws import positive
 from .positive_part import ExactPositivePart
 from .two_body import TwoBodyContact
@@ -90,25 +90,13 @@ def solve_penalty(bem, eps: float, gap, load=None, contact_label: str = "C",
 
     A gap that is never closed gives the zero-contact solution (reason "no contact").
     """
-    lame_body(bem)
     eps = positive("eps (penalty parameter)", eps)
     tol = positive("tol", tol)
     if isinstance(max_iter, bool) or int(max_iter) < 1:
         raise ValueError(f"max_iter must be >= 1, got {max_iter!r}")
-    if not np.any(bem.mesh.where(contact_label)):
-        raise ValueError(f"contact_label {contact_label!r}: no element carries this label")
-    body = BEBody(bem, S)
+    body, fixed, f = against_obstacle(bem, S, contact_label, dirichlet_label, load)
     pr = TwoBodyContact(body, RigidObstacle(gap), contact_label, eps_n=eps,
                         quadrature="exact")
-    f = None
-    if load is not None:
-        f = np.asarray(load, dtype=float)
-        if f.shape != (pr.ndofs,):
-            raise ValueError(f"load must have {pr.ndofs} entries, got {f.shape}")
-        if not np.all(np.isfinite(f)):
-            raise ValueError("load must be finite (NaN or inf entries)")
-    fixed = body.dofs_on(dirichlet_label) if np.any(bem.mesh.where(dirichlet_label)) \
-        else None
     res = pr.solve(f, fixed, rtol=tol, max_iter=max_iter, line_search=True, norm="max",
                    merit="energy", roundoff_stop=True)
     info = res.info.steps[-1]
