@@ -31,6 +31,8 @@ eliminated by the solver (``fixed_dofs``).
 
 from __future__ import annotations
 
+import dataclasses
+
 from typing import Optional, Sequence
 
 import numpy as np
@@ -38,6 +40,7 @@ import scipy.sparse as sp
 
 from ..bem.lame import LameBEM
 from ..fem.elasticity import ElasticBody
+from ..fem.plastic_body import ElastoPlasticFE
 from ..quadrature import gauss_legendre, gauss_lobatto
 from ..spaces import lagrange_values
 
@@ -256,6 +259,45 @@ class RigidObstacle:
         return np.zeros((0, 2))
 
 
+class PlasticFEBody(FEBody):
+    """An :class:`ElastoPlasticFE` as a contact body (kind "FE", the FEBody geometry of its
+    mesh); ``K`` is the elastic stiffness of the formulation, internal_force / commit the
+    plastic ones.
+
+    ``offset``: a displacement u_0 already carried by the body (e.g. the residual
+    displacement after an earlier touch).  The body's unknown is then v = u - u_0: its
+    geometry (segments, normals, coordinates, hence the contact gap) is the deformed
+    configuration x + u_0, and internal_force(v) = f_int(u_0 + v) of the small-strain
+    body with its committed history."""
+
+    linear = False
+
+    def __init__(self, fe: ElastoPlasticFE, offset=None):
+        if not isinstance(fe, ElastoPlasticFE):
+            raise ValueError(f"fe must be an ElastoPlasticFE, got {type(fe).__name__}")
+        if offset is None:
+            self.offset = np.zeros(fe.ndofs)
+            geometry = fe.elastic
+        else:
+            self.offset = np.asarray(offset, dtype=float).copy()
+            if self.offset.shape != (fe.ndofs,) or not np.all(np.isfinite(self.offset)):
+                raise ValueError(f"offset must be a finite vector of shape ({fe.ndofs},), "
+                                 f"got shape {self.offset.shape}")
+            moved = dataclasses.replace(fe.mesh, doflocs=fe.mesh.p
+                                        + fe.elastic.nodal_displacement(self.offset))
+            m = fe.material
+            geometry = ElasticBody(moved, m.E, m.nu, "strain")
+        super().__init__(geometry)
+        self.plastic = fe
+        self.K = fe.K
+
+    def internal_force(self, u):
+        return self.plastic.internal_force(self.offset + u)
+
+    def commit(self, u) -> None:
+        self.plastic.commit(self.offset + u)
+
+
 def pointwise(name: str, value, pts: np.ndarray, allow_negative: bool = True) -> np.ndarray:
     """A float or callable x -> values (None = 0), evaluated at the points (n, 2)."""
     if value is None:
@@ -306,13 +348,16 @@ def against_obstacle(bem, S, contact_label: str, dirichlet_label: str, load):
 
 
 def as_body(body, name: str = "body"):
-    """The contact body of an :class:`ElasticBody` (FE), a :class:`LameBEM` (BE), or a
-    body object already (FEBody, BEBody, RigidObstacle or any object with ``kind``)."""
+    """The contact body of an :class:`ElasticBody` (FE), an :class:`ElastoPlasticFE`
+    (plastic FE), a :class:`LameBEM` (BE), or a body object already (FEBody, BEBody,
+    PlasticFEBody, RigidObstacle or any object with ``kind`` and ``internal_force``)."""
+    if hasattr(body, "kind") and hasattr(body, "internal_force"):
+        return body
+    if isinstance(body, ElastoPlasticFE):
+        return PlasticFEBody(body)
     if isinstance(body, ElasticBody):
         return FEBody(body)
     if isinstance(body, LameBEM):
         return BEBody(body)
-    if hasattr(body, "kind") and hasattr(body, "internal_force"):
-        return body
     raise ValueError(f"{name} must be an ElasticBody, a LameBEM or a contact body, got "
                      f"{type(body).__name__}")

@@ -114,9 +114,11 @@ class LoadSteps:
         pr, free = self.pr, self.free
         fint, cs = pr.internal_force(U, self.slip, self.w)
         R = (fint - self.f)[free]
-        scale = max(np.abs(self.f[free]).max(initial=0.0),
-                    np.abs(cs["f_body"][free]).max(initial=0.0),
-                    np.abs(cs["f_c"][free]).max(initial=0.0), 1e-300)
+        # force scale of the stopping test: load, body and contact forces of the
+        # iterate, the reactions on the fixed dofs included (they keep the scale when
+        # the contact opens and the free forces vanish at equilibrium)
+        scale = max(np.abs(self.f).max(initial=0.0), np.abs(cs["f_body"]).max(initial=0.0),
+                    np.abs(cs["f_c"]).max(initial=0.0), 1e-300)
         merit = pr.energy(U, cs, self.f) if self.merit == "energy" \
             else float(np.linalg.norm(R))
         key = None

@@ -1,0 +1,477 @@
+"""Figures 4.1-4.12 (Section 4.2.7, thesis lines 14810-14920): an elastic stamp pressed
+onto an elastoplastic work piece, frictional penalty contact, Algorithm 4.1 (incremental
+loading, Newton), J2 flow theory with mixed hardening (4.21)-(4.22), radial return and
+its algorithmic tangent (4.38)-(4.43).
+
+Example 1 (figure_4_1 ... figure_4_5): the stamp (slave, elastic) at [0.2, 1.2] x [-1, 1]
+for the first touch and at [-1.8, -0.8] x [-1, 1] for the second, its top fixed; work
+piece (master, elastoplastic) [-2, 2] x [-3, -1], its bottom lifted by 4.3e-3 in
+increments; FE/FE and FE/BE (stamp by the Galerkin BEM, S_hat); deformed meshes (x100),
+||eps_p|| and ||dev sigma|| against the applied force at X = (-0.9, -1.1).
+Example 2 (figure_4_6 ... figure_4_12): one touch of the stamp [-1, 1] x [-1, 0], lift
+4.2e-3; ||dev sigma|| at X = (1, -1.1).  BE/BE (figure_4_10, figure_4_11 and the BE/BE
+curve of figure_4_12) needs the plastic BE body with Newton potentials (Section 4.2.4),
+which is not implemented: those artefacts say so and their claims are undecided.
+
+Core: :mod:`hpfebe.fem.plasticity` (return map), :mod:`hpfebe.fem.plastic_body` (B-bar
+Q1 work piece), :mod:`hpfebe.contact.stamping` (touches through
+:class:`hpfebe.contact.two_body.TwoBodyContact`).  The choices where the thesis is silent
+are :data:`CHOICES`.
+"""
+
+from __future__ import annotations
+
+import logging
+import time
+from dataclasses import asdict, dataclass
+
+import meshio
+import numpy as np
+import pandas as pd
+from matplotlib.collections import PolyCollection
+from matplotlib.figure import Figure
+
+from hpfebe.export import fe_vtu
+from hpfebe.fem.plasticity import J2Material
+from hpfebe.contact.stamping import (ContactSettings, curve_difference, element_areas,
+                                 field_difference, plastic_zone, stamp_body,
+                                 stamp_interior, touch, work_piece, zone_mismatch)
+from hpfebe.params import from_config
+from hpfebe.results import ArtefactResult, Claim, progress
+
+ARTEFACTS = ("figure_4_1", "figure_4_2", "figure_4_3", "figure_4_4", "figure_4_5",
+             "figure_4_6", "figure_4_7", "figure_4_8", "figure_4_9", "figure_4_10",
+             "figure_4_11", "figure_4_12")
+
+log = logging.getLogger(__name__)
+
+WORK = (-2.0, 2.0, -3.0, -1.0)
+STAMPS = {1: ((0.2, 1.2, -1.0, 1.0), (-1.8, -0.8, -1.0, 1.0)), 2: ((-1.0, 1.0, -1.0, 0.0),)}
+POINT = {1: (-0.9, -1.1), 2: (1.0, -1.1)}
+
+CHOICES = (
+    "Material of the work piece (not given in Section 4.2.7): sigma_Y = 4.0 and hardening "
+    "H = 450.0 of Section 4.4; E = 266926, nu = 0.29 in both bodies, plane strain with the "
+    "full 3 x 3 stress and plastic strain. theta (isotropic share of the hardening) is not "
+    "given: theta = 1 (isotropic) and theta = 0 (kinematic) are both run; figures of fields "
+    "show the first of config 'thetas'.",
+    "Friction and penalty (not given in Section 4.2.7): Coulomb mu_f = 0.2 and 1/eps_n = "
+    "10 E, 1/eps_t = 5 E of Table 4.3 (Section 4.4).",
+    "Work piece: Q1 with the mean-dilatation B-bar strain (locking free under isochoric "
+    "plastic flow); fully integrated Q1 is shown beside it in figure_4_12. Stamp: Q1 (FE) "
+    "or Galerkin BEM of degree be_degree (BE), mesh size h on both bodies.",
+    "Load path (Example 1; the thesis does not describe it): touch 1 lifts the bottom from "
+    "0 to 4.3e-3 in n_load equal increments and lowers it back to 0 in n_unload increments "
+    "(the contact opens); the stamp is then moved to its second place (a new, undeformed "
+    "stamp) and touch 2 repeats the lift. The work piece keeps its plastic history and its "
+    "residual displacement, whose deformed top is the contact geometry of touch 2.",
+    "Applied force = the vertical reaction at the work piece's bottom per unit thickness "
+    "(sum of the internal force over its y dofs). ||dev sigma|| and ||eps_p|| at X are "
+    "element means averaged over the elements touching X (X = (1, -1.1) lies on an element "
+    "edge).",
+    "Newton: each increment starts from the secant extrapolation of the last two converged "
+    "states (at the first unloading increment: the work piece lowered rigidly, the stamp "
+    "at rest), or from TwoBodyContact's bonded predictor when that lowers ||R||; Armijo "
+    "line search on ||R||, stop at ||R|| <= rtol x force scale + rtol sigma_Y width; a "
+    "failed increment is halved (at most max_cuts times).",
+    "Plastic zone = elements with mean ||eps_p|| > zone_tol.",
+)
+
+
+@dataclass(frozen=True)
+class Params:
+    E: float = 266926.0
+    nu: float = 0.29
+    sigma_Y: float = 4.0
+    H: float = 450.0
+    thetas: tuple[float, ...] = (1.0, 0.0)
+    mu_f: float = 0.2
+    eps_n_factor: float = 10.0
+    eps_t_factor: float = 5.0
+    rtol: float = 1e-8
+    max_newton: int = 40
+    max_cuts: int = 4
+    predictor: bool = True               # bonded predictor of TwoBodyContact per increment
+    h_levels: tuple[float, ...] = (0.2, 0.1, 0.05)
+    h_figure: float = 0.1
+    n_load: int = 10
+    n_unload: int = 2
+    ex1_u: float = 4.3e-3
+    ex2_u: float = 4.2e-3
+    be_degree: int = 1
+    magnification: float = 100.0
+    zone_tol: float = 1e-4
+    close_tol: float = 0.05          # curves "very close": max relative difference
+    similar_tol: float = 0.2         # fields / zones "similar": relative difference
+    locking_study: bool = True
+
+    def __post_init__(self):
+        if not self.thetas or any(not 0 <= t <= 1 for t in self.thetas):
+            raise ValueError(f"thetas must be values in [0, 1], got {self.thetas!r}")
+        if self.h_figure not in self.h_levels:
+            raise ValueError(f"h_figure must be one of h_levels {self.h_levels!r}, got "
+                             f"{self.h_figure!r}")
+        for name in ("ex1_u", "ex2_u", "magnification", "close_tol", "similar_tol"):
+            if not getattr(self, name) > 0:
+                raise ValueError(f"{name} must be positive, got {getattr(self, name)!r}")
+
+    @property
+    def settings(self) -> ContactSettings:
+        return ContactSettings(self.eps_n_factor, self.eps_t_factor, self.mu_f, self.rtol,
+                               self.max_newton, self.max_cuts, self.predictor)
+
+
+@dataclass
+class Run:
+    example: int
+    stamp: str
+    theta: float
+    h: float
+    formulation: str
+    fe: object
+    touches: list
+    wall_s: float
+
+    @property
+    def converged(self) -> bool:
+        return all(t.converged for t in self.touches)
+
+    @property
+    def records(self) -> list:
+        return [r for t in self.touches for r in t.records]
+
+
+# --------------------------------------------------------------------------- computation
+def run_example(prm: Params, example: int, stamp: str, theta: float, h: float,
+                formulation: str = "bbar") -> Run:
+    """All touches of one example with one stamp discretisation, theta and mesh size."""
+    t0 = time.perf_counter()
+    mat = J2Material(prm.E, prm.nu, prm.sigma_Y, prm.H, theta)
+    fe = work_piece(WORK, h, mat, formulation)
+    u_total = prm.ex1_u if example == 1 else prm.ex2_u
+    touches, offset = [], None
+    for k, box in enumerate(STAMPS[example], start=1):
+        body = stamp_body(stamp, box, h, prm.E, prm.nu, p=prm.be_degree)
+        tr = touch(body, fe, u_total, prm.n_load, prm.n_unload, POINT[example],
+                   prm.settings, offset=offset, touch_id=k)
+        touches.append(tr)
+        if not tr.converged:
+            log.warning("example %d %s theta=%g h=%g: %s", example, stamp, theta, h,
+                        tr.reason)
+            break
+        offset = tr.u_work
+    return Run(example, stamp, theta, h, formulation, fe, touches, time.perf_counter() - t0)
+
+
+def all_runs(prm: Params) -> dict:
+    """{(example, stamp, theta, h, formulation): Run}."""
+    jobs = [(ex, st, th, h, "bbar") for ex in (1, 2) for th in prm.thetas
+            for st in ("FE", "BE") for h in prm.h_levels]
+    if prm.locking_study:
+        jobs += [(2, "FE", prm.thetas[0], h, "full") for h in prm.h_levels]
+    return {j: run_example(prm, *j) for j in progress(jobs, desc="stamping runs")}
+
+
+def curve_table(runs: dict, example: int) -> pd.DataFrame:
+    rows = []
+    for (ex, st, th, h, form), r in runs.items():
+        if ex != example:
+            continue
+        for k, rec in enumerate(r.records):
+            rows.append(dict(example=ex, coupling=f"FE/{st}" if st == "BE" else "FE/FE",
+                             theta=th, h=h, formulation=form, increment=k + 1,
+                             **asdict(rec)))
+    return pd.DataFrame(rows)
+
+
+def summary_table(prm: Params, runs: dict, example: int) -> pd.DataFrame:
+    rows = []
+    for (ex, st, th, h, form), r in runs.items():
+        if ex != example:
+            continue
+        f = r.touches[-1].peak.fields if r.touches[-1].peak else r.fe.fields()
+        zone = plastic_zone(r.fe, r.fe.fields()["eps_p_norm_mean"], prm.zone_tol)
+        its = [rec.iterations for rec in r.records]
+        rows.append(dict(example=ex, coupling="FE/BE" if st == "BE" else "FE/FE",
+                         theta=th, h=h, formulation=form, dof_work=r.fe.ndofs,
+                         converged=r.converged,
+                         eps_p_max=float(r.fe.fields()["eps_p_norm_mean"].max()),
+                         dev_sigma_max_peak=float(f["dev_sigma_norm"].max()),
+                         plastic_area=float(element_areas(r.fe)[zone].sum()),
+                         newton_total=int(sum(its)), newton_max=int(max(its, default=0)),
+                         newton_mean=float(np.mean(its)) if its else float("nan"),
+                         newton_per_increment=" ".join(map(str, its)),
+                         wall_time_s=r.wall_s))
+    return pd.DataFrame(rows)
+
+
+# --------------------------------------------------------------------------- comparisons
+def _curve(run: Run, touch_id=None) -> np.ndarray:
+    return np.array([r.dev_sigma_X for r in run.records
+                     if touch_id is None or r.touch == touch_id])
+
+
+def coupling_claim(prm: Params, runs: dict, example: int) -> Claim:
+    """FE/FE and FE/BE curves of ||dev sigma|| at X very close (max relative difference
+    along the load path, at h_figure and on every mesh), beside the mesh differences."""
+    parts, ev = [], []
+    for th in prm.thetas:
+        d = {h: curve_difference(_curve(runs[(example, "FE", th, h, "bbar")]),
+                                 _curve(runs[(example, "BE", th, h, "bbar")]))
+             for h in prm.h_levels}
+        hs = prm.h_levels
+        mesh = [curve_difference(_curve(runs[(example, "FE", th, hs[i + 1], "bbar")]),
+                                 _curve(runs[(example, "FE", th, hs[i], "bbar")]))
+                for i in range(len(hs) - 1)]
+        ok = d[prm.h_figure] <= prm.close_tol
+        parts.append(ok)
+        ev.append(f"theta={th:g}: max rel. difference FE/FE vs FE/BE "
+                  + ", ".join(f"h={h:g}: {v:.2%}" for h, v in d.items())
+                  + "; FE/FE between successive meshes "
+                  + ", ".join(f"{v:.2%}" for v in mesh))
+    return Claim(f"FE/FE and FE/BE curves of ||dev sigma|| at X = {POINT[example]} are very "
+                 f"close (max relative difference <= {prm.close_tol:.0%} at h = "
+                 f"{prm.h_figure:g})", bool(all(parts)), "; ".join(ev))
+
+
+def zone_claim(prm: Params, runs: dict, example: int) -> Claim:
+    """Similar plastic deformation in FE/FE and FE/BE: L2 difference of ||eps_p|| and
+    mismatch of the plastic zones (same work piece mesh) after the last touch."""
+    ok, ev = [], []
+    for th in prm.thetas:
+        for h in prm.h_levels:
+            a, b = runs[(example, "FE", th, h, "bbar")], runs[(example, "BE", th, h, "bbar")]
+            fa = a.fe.fields()["eps_p_norm_mean"]
+            fb = b.fe.fields()["eps_p_norm_mean"]
+            diff = field_difference(a.fe, fa, fb)
+            mis = zone_mismatch(a.fe, plastic_zone(a.fe, fa, prm.zone_tol),
+                                plastic_zone(b.fe, fb, prm.zone_tol))
+            if h == prm.h_figure:
+                ok.append(diff <= prm.similar_tol and mis <= prm.similar_tol)
+            ev.append(f"theta={th:g} h={h:g}: ||eps_p|| L2 difference {diff:.2%}, zone "
+                      f"mismatch {mis:.2%}")
+    return Claim(f"similar plastic deformations in the work piece for FE and BE stamps "
+                 f"(L2 difference of ||eps_p|| and plastic zone mismatch <= "
+                 f"{prm.similar_tol:.0%} at h = {prm.h_figure:g})", bool(all(ok)),
+                 "; ".join(ev))
+
+
+def dent_claim(prm: Params, run: Run) -> Claim:
+    """The stamp leaves a permanent dent: residual top displacement under each stamp
+    after unloading, relative to the lift."""
+    fe, ev, ok = run.fe, [], []
+    u_total = prm.ex1_u if run.example == 1 else prm.ex2_u
+    top = fe.elastic.boundary_vertices("top")
+    x = fe.mesh.p[0, top]
+    for tr, box in zip(run.touches, STAMPS[run.example]):
+        uy = fe.elastic.nodal_displacement(tr.u_work)[1, top]
+        under = (x >= box[0]) & (x <= box[1])
+        dent = float(-uy[under].mean())
+        ok.append(dent > 0.5 * u_total)
+        ev.append(f"touch {tr.records[0].touch}: mean residual depth under the stamp "
+                  f"{dent:.3e} ({dent / u_total:.0%} of the lift), deepest "
+                  f"{-uy[under].min():.3e}")
+    return Claim("the stamp leaves a permanent (plastic) dent in the work piece at each "
+                 "touch (mean residual depth under the stamp > 50 % of the lift)",
+                 bool(all(ok)), "; ".join(ev))
+
+
+def mesh_claim(prm: Params, runs: dict) -> Claim:
+    """Beyond the thesis: the B-bar curves converge under refinement, the fully integrated
+    Q1 curves lie apart (locking)."""
+    th, hs = prm.thetas[0], prm.h_levels
+    bb = [_curve(runs[(2, "FE", th, h, "bbar")]) for h in hs]
+    d = [curve_difference(bb[i + 1], bb[i]) for i in range(len(hs) - 1)]
+    shrink = all(d[i + 1] < d[i] for i in range(len(d) - 1)) if len(d) > 1 else None
+    areas = [float(element_areas(r.fe)[plastic_zone(r.fe, r.fe.fields()["eps_p_norm_mean"],
+                                                     prm.zone_tol)].sum())
+             for r in (runs[(2, "FE", th, h, "bbar")] for h in hs)]
+    ev = ("B-bar, successive meshes: " + ", ".join(f"{v:.2%}" for v in d) +
+          "; plastic zone area " + ", ".join(f"h={h:g}: {a:.3f}" for h, a in zip(hs, areas)))
+    if prm.locking_study:
+        full = [curve_difference(bb[i], _curve(runs[(2, "FE", th, h, "full")]))
+                for i, h in enumerate(hs)]
+        ev += "; fully integrated Q1 vs B-bar on the same mesh: " + \
+            ", ".join(f"h={h:g}: {v:.2%}" for h, v in zip(hs, full))
+    return Claim("(beyond the thesis) the ||dev sigma|| curve converges under mesh refinement "
+                 "(differences between successive meshes shrink)",
+                 None if shrink is None else bool(shrink), ev)
+
+
+# --------------------------------------------------------------------------- plots
+def _polys(p: np.ndarray, cells: np.ndarray) -> np.ndarray:
+    return p[cells]                                        # (ncells, nv, 2)
+
+
+def _draw(ax, prm: Params, snap, fe, field: str | None, vmax: float):
+    """Deformed (x magnification) work piece and stamp; cells coloured by ``field``."""
+    mag = prm.magnification
+    pw = fe.mesh.p.T + mag * fe.elastic.nodal_displacement(snap.u_work).T
+    ps, us, cs = stamp_interior(snap.stamp, snap.u_stamp, *_grid(snap.stamp, prm))
+    kw = dict(edgecolors="k", linewidths=0.2)
+    if field is None:
+        ax.add_collection(PolyCollection(_polys(pw, fe.mesh.t.T), facecolors="lightsteelblue",
+                                         **kw))
+        ax.add_collection(PolyCollection(_polys(ps + mag * us, cs), facecolors="wheat", **kw))
+        pc = None
+    else:
+        pc = PolyCollection(_polys(pw, fe.mesh.t.T), array=snap.fields[field],
+                            cmap="jet", **kw)
+        pc.set_clim(0.0, vmax)
+        ax.add_collection(pc)
+        st = PolyCollection(_polys(ps + mag * us, cs), array=np.zeros(len(cs)), cmap="jet",
+                            **kw)
+        st.set_clim(0.0, vmax)
+        ax.add_collection(st)
+    ax.set_xlim(-2.2, 2.2)
+    ax.set_ylim(-3.2, 1.2)
+    ax.set_aspect("equal")
+    return pc
+
+
+def _grid(stamp, prm: Params):
+    """Cells of the auxiliary FE-like grid of a BE stamp (mesh size h_figure)."""
+    if hasattr(stamp, "mesh") and hasattr(stamp.mesh, "a"):
+        lo, hi = stamp.mesh.a.min(axis=0), stamp.mesh.a.max(axis=0)
+        return (max(1, int(round((hi[0] - lo[0]) / prm.h_figure))),
+                max(1, int(round((hi[1] - lo[1]) / prm.h_figure))))
+    return (0, 0)
+
+
+def field_figure(prm: Params, run: Run, field: str | None, title: str) -> Figure:
+    snaps = [t.peak for t in run.touches if t.peak is not None]
+    fig = Figure(figsize=(5.0 * len(snaps), 5.0))
+    axes = fig.subplots(1, len(snaps), squeeze=False)[0]
+    vmax = max(float(s.fields["eps_p_norm"].max()) for s in snaps) if field else 0.0
+    for ax, s in zip(axes, snaps):
+        pc = _draw(ax, prm, s, run.fe, field, vmax or 1.0)
+        ax.set_title(f"{title}, touch {s.touch} at full lift (x{prm.magnification:g})",
+                     fontsize=9)
+    if pc is not None:
+        fig.colorbar(pc, ax=axes.tolist(), shrink=0.7, label="||eps_p||")
+    return fig
+
+
+def curve_figure(prm: Params, runs: dict, example: int) -> Figure:
+    th0 = prm.thetas
+    ncol = len(th0) + 1
+    fig = Figure(figsize=(4.8 * ncol, 4.2))
+    axes = fig.subplots(1, ncol)
+    for ax, th in zip(axes, th0):
+        for st, style in (("FE", "-o"), ("BE", "--s")):
+            r = runs[(example, st, th, prm.h_figure, "bbar")]
+            start = (0.0, 0.0)
+            for t in r.touches:
+                load = [x for x in t.records if x.phase == "load"]
+                ax.plot([start[0]] + [x.force for x in load],
+                        [start[1]] + [x.dev_sigma_X for x in load], style, ms=3,
+                        label=f"FE/{st}, touch {t.records[0].touch}" if t.records else None)
+                if t.records:
+                    start = (t.records[-1].force, t.records[-1].dev_sigma_X)
+        ax.set_title(f"theta = {th:g}, h = {prm.h_figure:g}", fontsize=9)
+        ax.set_xlabel("applied force (bottom reaction)")
+        ax.set_ylabel(f"||dev sigma|| at X = {POINT[example]}")
+        ax.legend(fontsize=7)
+    ax = axes[-1]
+    last = len(STAMPS[example])
+    for i, h in enumerate(prm.h_levels):
+        forms = ("bbar", "full") if example == 2 and prm.locking_study else ("bbar",)
+        for form, style in zip(forms, ("-", ":")):
+            recs = runs[(example, "FE", th0[0], h, form)].records
+            start = [x for x in recs if x.touch == last - 1][-1:] or [None]
+            load = [x for x in recs if x.touch == last and x.phase == "load"]
+            f0, s0 = (0.0, 0.0) if start[0] is None else (start[0].force, start[0].dev_sigma_X)
+            ax.plot([f0] + [x.force for x in load], [s0] + [x.dev_sigma_X for x in load],
+                    style, color=f"C{i}",
+                    label=f"FE/FE {'B-bar' if form == 'bbar' else 'full Q1'} h={h:g}")
+    ax.set_title(f"mesh study, theta = {th0[0]:g}, touch {last}", fontsize=9)
+    ax.set_xlabel("applied force")
+    ax.legend(fontsize=6)
+    fig.tight_layout()
+    return fig
+
+
+def vtu_exports(prm: Params, run: Run, tag: str) -> dict:
+    """Work piece (displacement, element fields ||eps_p||, ||dev sigma||, alpha) and stamp
+    (displacement; a BE stamp on its auxiliary grid) at the peak of every touch."""
+    out = {}
+    for t in run.touches:
+        if t.peak is None:
+            continue
+        s = t.peak
+        wp = fe_vtu(run.fe.mesh, {"u": run.fe.elastic.nodal_displacement(s.u_work).T})
+        wp.cell_data = {k: [np.asarray(v, dtype=float)] for k, v in s.fields.items()}
+        out[f"{tag}_touch{s.touch}_work"] = wp
+        pts, disp, cells = stamp_interior(s.stamp, s.u_stamp, *_grid(s.stamp, prm))
+        z = np.zeros((len(pts), 1))
+        out[f"{tag}_touch{s.touch}_stamp"] = meshio.Mesh(
+            np.hstack([pts, z]), [("quad", np.asarray(cells))],
+            point_data={"u": np.hstack([disp, z])})
+    return out
+
+
+def missing_figure(text: str) -> Figure:
+    fig = Figure(figsize=(6, 2))
+    ax = fig.subplots()
+    ax.axis("off")
+    ax.text(0.5, 0.5, text, ha="center", va="center", wrap=True, fontsize=9)
+    return fig
+
+
+# --------------------------------------------------------------------------- artefacts
+BEBE = ("BE/BE (plastic work piece by the BEM with Newton potentials, Section 4.2.4, "
+        "Algorithm 4.2) is not implemented in this round: not computed.")
+
+
+def field_artefacts(prm, runs, example, ids, notes, meta) -> list[ArtefactResult]:
+    """Deformed mesh and ||eps_p|| artefacts of FE/FE and FE/BE (ids in that order)."""
+    th = prm.thetas[0]
+    out = []
+    summ = summary_table(prm, runs, example)
+    for k, st in enumerate(("FE", "BE")):
+        run = runs[(example, st, th, prm.h_figure, "bbar")]
+        label = "FE/FE" if st == "FE" else "FE/BE"
+        claims_mesh = [dent_claim(prm, run)]
+        claims_eps = [zone_claim(prm, runs, example)] if st == "BE" else [Claim(
+            "plastic deformation under every touch of the stamp", bool(
+                all(t.peak is not None and t.peak.fields["eps_p_norm"].max() > prm.zone_tol
+                    for t in run.touches)),
+            "max ||eps_p|| at the peak of each touch: " + ", ".join(
+                f"{t.peak.fields['eps_p_norm'].max():.3e}" for t in run.touches if t.peak))]
+        tab = summ[summ.coupling == label].reset_index(drop=True)
+        out.append(ArtefactResult(ids[2 * k], tab, field_figure(prm, run, None,
+                                  f"{label} deformed mesh"), claims=claims_mesh,
+                                  notes=notes, meta=meta))
+        out.append(ArtefactResult(ids[2 * k + 1], tab, field_figure(
+            prm, run, "eps_p_norm", f"{label} ||eps_p||"), claims=claims_eps, notes=notes,
+            meta=meta, exports=vtu_exports(prm, run, label.replace("/", ""))))
+    return out
+
+
+def run(config: dict, quick: bool = False) -> list[ArtefactResult]:
+    """Figures 4.1-4.12 (``quick`` unused: config/quick.yaml sets the sizes)."""
+    prm = from_config(Params, config, scene="ch4_plasticity")
+    t0 = time.perf_counter()
+    runs = all_runs(prm)
+    failed = [f"{k}: {t.reason}" for k, r in runs.items() for t in r.touches if not t.converged]
+    notes = " ".join(CHOICES) + (" FAILED RUNS: " + "; ".join(failed) if failed else "")
+    its = [rec.iterations for r in runs.values() for rec in r.records]
+    meta = dict(run_s=time.perf_counter() - t0, runs=len(runs), all_converged=not failed,
+                newton_total=int(sum(its)), newton_max_per_increment=int(max(its)),
+                newton_mean_per_increment=float(np.mean(its)))
+    ex1 = field_artefacts(prm, runs, 1, ARTEFACTS[0:4], notes, meta)
+    c1 = curve_table(runs, 1)
+    fig5 = ArtefactResult("figure_4_5", c1, curve_figure(prm, runs, 1),
+                          claims=[coupling_claim(prm, runs, 1)], notes=notes, meta=meta)
+    ex2 = field_artefacts(prm, runs, 2, ARTEFACTS[5:9], notes, meta)
+    empty = pd.DataFrame({"coupling": ["BE/BE"], "computed": [False]})
+    bebe = [ArtefactResult(a, empty, missing_figure(BEBE),
+                           claims=[Claim(c, None, BEBE)], notes=notes, meta=meta)
+            for a, c in (("figure_4_10", "BE/BE deformed mesh qualitatively as FE/FE"),
+                         ("figure_4_11", "BE/BE ||eps_p|| qualitatively as FE/FE"))]
+    c2 = curve_table(runs, 2)
+    fig12 = ArtefactResult("figure_4_12", c2, curve_figure(prm, runs, 2), claims=[
+        coupling_claim(prm, runs, 2),
+        Claim("the BE/BE curve shows qualitatively similar behaviour", None, BEBE),
+        mesh_claim(prm, runs)], notes=notes, meta=meta)
+    return ex1 + [fig5] + ex2 + bebe + [fig12]

@@ -1,0 +1,306 @@
+"""The stamping examples of Section 4.2.7 (thesis lines 14810-14920): an elastic stamp
+(slave; FE :class:`~hpfebe.fem.elasticity.ElasticBody` or BE
+:class:`~hpfebe.bem.lame.LameBEM`) pressed onto an elastoplastic work piece (master,
+:class:`~hpfebe.fem.plastic_body.ElastoPlasticFE`, J2 flow (4.21)-(4.22)) by lifting the
+work piece's bottom; frictional penalty contact by
+:class:`hpfebe.contact.two_body.TwoBodyContact` (Algorithm 4.1: incremental loading,
+semismooth Newton with the algorithmic tangents (4.36)-(4.43) of the plastic body).
+
+One *touch* (:func:`touch`): stamp top fixed, work piece bottom u_y = g (u_x = 0) with g
+raised from 0 to ``u_total`` in ``n_load`` equal increments and lowered back to 0 in
+``n_unload`` increments.  Every increment is one :meth:`TwoBodyContact.solve` continued
+from the last converged state (``initial``) with the prescribed values ramped from the
+last to the new ones (a cut increment is halved between them); Newton starts from the
+secant extrapolation of the last two converged states, at the first unloading increment
+from the rigidly lowered work piece (the plastic body's force is a pure function of the
+displacement and its committed history, so the start only changes the iteration count:
+measured 3-6 Newton iterations per loading increment after the first instead of 15-20
+from the last state).  The plastic history is committed after each converged increment.
+
+A second touch (Example 1) starts from the state left by the first: the work piece keeps
+its committed history and carries the residual displacement of the first touch as an
+``offset`` (its contact geometry is the deformed one, :class:`PlasticFEBody`).
+
+Recorded per converged increment (:class:`StepRecord`): the prescribed g, the applied
+force (the vertical reaction at the work piece's bottom, sum of f_int over its y dofs,
+per unit thickness), ||dev sigma|| and ||eps_p|| at the characteristic point X (element
+means, averaged over the elements touching X), Newton iterations.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..bem.lame import LameBEM
+from ..geometry import BoundaryMesh
+from ..fem.elasticity import ElasticBody, rectangle_mesh
+from ..fem.plastic_body import ElastoPlasticFE
+from ..fem.plasticity import J2Material
+from .bodies import BEBody, PlasticFEBody
+from .two_body import TwoBodyContact
+
+SIDES = ("bottom", "right", "top", "left")
+STAMP_KINDS = ("FE", "BE")
+
+
+@dataclass(frozen=True)
+class ContactSettings:
+    """Penalty and solver data: 1/eps_n = eps_n_factor E, 1/eps_t = eps_t_factor E,
+    Coulomb mu_f; Newton tolerance rtol (relative to the force scale), max_iter, at most
+    max_cuts halvings per increment; ``predictor``: TwoBodyContact's bonded predictor
+    (taken when it lowers the merit; measured: the first increment of the second touch
+    of Example 1 at h = 0.1 needs 33 iterations with it, 98 in 3 attempts without)."""
+
+    eps_n_factor: float = 10.0
+    eps_t_factor: float = 5.0
+    mu_f: float = 0.2
+    rtol: float = 1e-8
+    max_iter: int = 40
+    max_cuts: int = 4
+    predictor: bool = True
+
+    def __post_init__(self):
+        for name in ("eps_n_factor", "eps_t_factor", "rtol"):
+            if not getattr(self, name) > 0:
+                raise ValueError(f"{name} must be positive, got {getattr(self, name)!r}")
+        if self.mu_f < 0:
+            raise ValueError(f"mu_f must be >= 0, got {self.mu_f!r}")
+        if self.max_iter < 1 or self.max_cuts < 0:
+            raise ValueError(f"max_iter must be >= 1 and max_cuts >= 0, got "
+                             f"{self.max_iter!r}, {self.max_cuts!r}")
+
+
+@dataclass
+class StepRecord:
+    touch: int
+    phase: str              # "load" / "unload"
+    g: float                # prescribed lift of the work piece's bottom
+    force: float            # vertical reaction at the bottom (per unit thickness)
+    dev_sigma_X: float
+    eps_p_X: float
+    iterations: int
+    attempts: int           # Newton runs (1 + cuts)
+
+
+@dataclass
+class Snapshot:
+    """State at the peak of a touch: the stamp (body object and its dof vector), the work
+    piece's total displacement (dofs), its committed fields (element means) and the
+    contact result."""
+
+    touch: int
+    stamp: object
+    u_stamp: np.ndarray
+    u_work: np.ndarray
+    fields: dict
+    result: object = None
+
+
+@dataclass
+class TouchResult:
+    records: list = field(default_factory=list)
+    peak: Snapshot | None = None
+    u_work: np.ndarray | None = None      # total work piece displacement at the end
+    converged: bool = True
+    reason: str = "converged"
+
+
+def stamp_body(kind: str, box, h: float, E: float, nu: float, p: int = 1,
+               mesh_kind: str = "quad"):
+    """The elastic stamp on ``box`` = (x0, x1, y0, y1) with mesh size h: FE (Q1/P1
+    rectangle mesh) or BE (Galerkin, degree p, the four sides labelled like the FE
+    mesh)."""
+    if kind not in STAMP_KINDS:
+        raise ValueError(f"kind must be one of {STAMP_KINDS}, got {kind!r}")
+    x0, x1, y0, y1 = box
+    nx, ny = _cells(x1 - x0, h), _cells(y1 - y0, h)
+    if kind == "FE":
+        return ElasticBody(rectangle_mesh(x0, x1, y0, y1, nx, ny, mesh_kind), E, nu)
+    mesh = BoundaryMesh.polygon([(x0, y0), (x1, y0), (x1, y1), (x0, y1)],
+                                n=[nx, ny, nx, ny], labels=list(SIDES), p=p)
+    return LameBEM(mesh, E, nu, "strain")
+
+
+def work_piece(box, h: float, material: J2Material, formulation: str = "bbar",
+               mesh_kind: str = "quad") -> ElastoPlasticFE:
+    x0, x1, y0, y1 = box
+    m = rectangle_mesh(x0, x1, y0, y1, _cells(x1 - x0, h), _cells(y1 - y0, h), mesh_kind)
+    return ElastoPlasticFE(m, material, formulation)
+
+
+def _cells(length: float, h: float) -> int:
+    if not h > 0:
+        raise ValueError(f"h must be positive, got {h!r}")
+    return max(1, int(round(length / h)))
+
+
+def lift_schedule(u_total: float, n_load: int, n_unload: int) -> np.ndarray:
+    """g after each increment: n_load equal steps up to u_total, n_unload down to 0."""
+    for name, n in (("n_load", n_load), ("n_unload", n_unload)):
+        if isinstance(n, bool) or int(n) != n or n < (1 if name == "n_load" else 0):
+            raise ValueError(f"{name} must be an integer >= {1 if name == 'n_load' else 0}, "
+                             f"got {n!r}")
+    up = u_total * np.arange(1, n_load + 1) / n_load
+    down = u_total * (1.0 - np.arange(1, n_unload + 1) / n_unload) if n_unload else []
+    return np.concatenate([up, down])
+
+
+def touch(stamp, fe: ElastoPlasticFE, u_total: float, n_load: int, n_unload: int,
+          X, settings: ContactSettings, offset=None, touch_id: int = 1) -> TouchResult:
+    """One touch (module doc): returns the per-increment records, the snapshot at the
+    peak and the work piece's total displacement at the end (the offset of a next
+    touch).  A failed increment (after ``max_cuts`` cuts) ends the touch with its reason;
+    the committed history is that of the last converged increment."""
+    body = PlasticFEBody(fe, offset)
+    E = fe.material.E
+    pr = TwoBodyContact(stamp, body, "bottom", "top",
+                        eps_n=1.0 / (settings.eps_n_factor * E),
+                        eps_t=1.0 / (settings.eps_t_factor * E), mu_f=settings.mu_f)
+    top = pr.dofs_on("slave", "top")
+    bx, by = pr.dofs_on("master", "bottom", 0), pr.dofs_on("master", "bottom", 1)
+    fixed = np.concatenate([top, bx, by])
+    is_y = np.concatenate([np.zeros(top.size + bx.size, bool), np.ones(by.size, bool)])
+    bottom_y = fe.elastic.dofs_on("bottom", 1)
+    work_y = pr.global_dofs("master", fe.elastic.nodal_dofs[1])
+    # absolute floor of the stopping test: rtol x sigma_Y x width, the force scale of
+    # the plastic work piece (when the stamp is lifted off, the forces at equilibrium
+    # shrink to residual stresses and the relative test alone asks for more digits)
+    width = float(np.ptp(fe.mesh.p[0]))
+    atol = settings.rtol * fe.material.sigma_Y * width
+    out = TouchResult()
+    res, hist = None, []                       # hist: (g, U) of converged increments
+    g_prev = 0.0
+    sched = lift_schedule(u_total, n_load, n_unload)
+    for k, g in enumerate(sched):
+        def values(lam, a=g_prev, b=g):
+            return np.where(is_y, a + lam * (b - a), 0.0)
+        init = _extrapolated(res, hist, g, work_y)
+        new = pr.solve(None, fixed, values, load_factors=[1.0], rtol=settings.rtol,
+                       max_iter=settings.max_iter, max_cuts=settings.max_cuts,
+                       atol=atol, line_search=True, predictor=settings.predictor,
+                       initial=init)
+        if not new.converged:
+            out.converged = False
+            out.reason = f"touch {touch_id}, increment {k + 1} (g = {g:.3e}): {new.reason}"
+            break
+        res = new
+        hist.append((g, res.U.copy()))
+        g_prev = g
+        out.records.append(StepRecord(
+            touch_id, "load" if k < n_load else "unload", float(g),
+            float(fe.committed_force()[bottom_y].sum()),
+            fe.value_at("dev_sigma_norm", X), fe.value_at("eps_p_norm", X),
+            int(res.info.iterations), len(res.info.steps)))
+        if k == n_load - 1:
+            out.peak = Snapshot(touch_id, stamp, res.u_slave.copy(),
+                                body.offset + res.u_master, _mean_fields(fe), res)
+    if res is not None:
+        out.u_work = body.offset + res.u_master
+    return out
+
+
+def _extrapolated(res, hist, g, shift):
+    """The Newton start of the next increment: the last converged result with U
+    replaced by the secant extrapolation to the prescribed value g (None before the
+    first increment).  At a reversal of the lift (unloading) the extrapolation points the
+    wrong way; there the start is U1 with the work piece's y dofs ``shift`` translated
+    by g - g1 and the stamp at rest: the plastic work piece springs back by
+    O(sigma_Y / E) x height only, far less than the lift, so the contact opens."""
+    if res is None:
+        return None
+    if len(hist) == 1:
+        (g1, U1), (g0, U0) = hist[-1], (0.0, np.zeros_like(res.U))
+    else:
+        (g1, U1), (g0, U0) = hist[-1], hist[-2]
+    if (g - g1) * (g1 - g0) > 0:
+        return dataclasses.replace(res, U=U1 + (g - g1) / (g1 - g0) * (U1 - U0))
+    U = U1.copy()
+    U[shift] += g - g1
+    U[:res.u_slave.size] = 0.0
+    return dataclasses.replace(res, U=U)
+
+
+def _mean_fields(fe: ElastoPlasticFE) -> dict:
+    f = fe.fields()
+    return {k[:-5]: v.copy() for k, v in f.items() if k.endswith("_mean")}
+
+
+def stamp_interior(stamp, u_stamp: np.ndarray, nx: int, ny: int):
+    """Displacement of the stamp on the vertices of an nx x ny grid of its box: FE nodal
+    values (the mesh's own vertices when nx, ny are its cells), BE through the
+    representation formula at interior grid points and the trace on the boundary (as
+    the thesis does for Figures 4.3, 4.8).  Returns (grid points (n, 2), displacement
+    (n, 2), quad cells (m, 4))."""
+    if isinstance(stamp, ElasticBody):
+        p = stamp.mesh.p.T
+        return p, stamp.nodal_displacement(u_stamp).T, stamp.mesh.t.T
+    m = stamp.mesh
+    lo, hi = np.min(m.a, axis=0), np.max(m.a, axis=0)
+    xs, ys = np.linspace(lo[0], hi[0], nx + 1), np.linspace(lo[1], hi[1], ny + 1)
+    X, Y = np.meshgrid(xs, ys, indexing="xy")
+    pts = np.column_stack([X.ravel(), Y.ravel()])
+    tol = 1e-12 * float(np.max(hi - lo))
+    inside = (pts[:, 0] > lo[0] + tol) & (pts[:, 0] < hi[0] - tol) & \
+             (pts[:, 1] > lo[1] + tol) & (pts[:, 1] < hi[1] - tol)
+    disp = np.zeros_like(pts)
+    disp[inside] = stamp.representation(pts[inside], u_stamp, stamp.Psi(u_stamp))
+    disp[~inside] = _be_trace(stamp, u_stamp, pts[~inside])
+    i = np.arange(nx)[None, :] + (nx + 1) * np.arange(ny)[:, None]
+    cells = np.stack([i, i + 1, i + nx + 2, i + nx + 1], axis=-1).reshape(-1, 4)
+    return pts, disp, cells
+
+
+def _be_trace(stamp: LameBEM, u: np.ndarray, pts: np.ndarray) -> np.ndarray:
+    """The BE boundary displacement (V_hp^2) at boundary points: located on their
+    element, evaluated with the element's Lagrange basis."""
+    b = BEBody(stamp)
+    m = stamp.mesh
+    d = m.b - m.a
+    rel = pts[:, None, :] - m.a[None]
+    s = np.clip(np.einsum("nec,ec->ne", rel, d) / np.einsum("ec,ec->e", d, d), 0.0, 1.0)
+    dist = np.linalg.norm(rel - s[..., None] * d[None], axis=-1)
+    e = np.argmin(dist, axis=1)
+    sp_ = s[np.arange(len(pts)), e]
+    cols, vals = b.trace(e, sp_)
+    return np.stack([np.einsum("nk,nk->n", vals, u[cols[:, c]]) for c in (0, 1)], axis=1)
+
+
+# --------------------------------------------------------------------------- comparisons
+def element_areas(fe: ElastoPlasticFE) -> np.ndarray:
+    """|K| of every element of the work piece (sum of its quadrature weights)."""
+    return fe.dx.sum(axis=1)
+
+
+def plastic_zone(fe: ElastoPlasticFE, eps_p_mean: np.ndarray, tol: float) -> np.ndarray:
+    """Mask of the elements whose mean ||eps_p|| exceeds ``tol``."""
+    if not tol >= 0:
+        raise ValueError(f"tol must be >= 0, got {tol!r}")
+    return np.asarray(eps_p_mean) > tol
+
+
+def zone_mismatch(fe: ElastoPlasticFE, a: np.ndarray, b: np.ndarray) -> float:
+    """|A symmetric-difference B| / |A union B| of two element masks (0 = same zone)."""
+    w = element_areas(fe)
+    union = float(w[a | b].sum())
+    return float(w[a ^ b].sum()) / union if union > 0 else 0.0
+
+
+def field_difference(fe: ElastoPlasticFE, a: np.ndarray, b: np.ndarray) -> float:
+    """||a - b||_L2 / ||a||_L2 of two element-wise constant fields on the work piece."""
+    w = element_areas(fe)
+    na = float(np.sqrt(w @ np.asarray(a) ** 2))
+    return float(np.sqrt(w @ (np.asarray(a) - np.asarray(b)) ** 2)) / na if na > 0 else 0.0
+
+
+def curve_difference(a, b) -> float:
+    """max_k |a_k - b_k| / max_k |a_k|: the largest difference of two curves sampled at
+    the same load increments, relative to the first curve's peak."""
+    a, b = np.asarray(a, dtype=float), np.asarray(b, dtype=float)
+    if a.shape != b.shape or a.size == 0:
+        raise ValueError(f"curves must be non-empty and of equal length, got {a.shape}, "
+                         f"{b.shape}")
+    peak = float(np.abs(a).max())
+    return float(np.abs(a - b).max()) / peak if peak > 0 else float(np.abs(b).max())

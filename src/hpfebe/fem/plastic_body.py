@@ -1,0 +1,272 @@
+"""An elastoplastic FE body (J2 flow theory, :mod:`hpfebe.fem.plasticity`) for Chapter 4's
+work piece (Sections 4.2.2-4.2.3, 4.2.6): P1 triangles or Q1 quadrilaterals (scikit-fem),
+history (eps_p, alpha, beta) at the quadrature points, internal force and algorithmic
+tangent assembled vectorised (numpy matmul/einsum over elements and points).
+
+    f_int(u)_i = sum_K sum_q w_q B_i(x_q) : sigma(eps(u)(x_q); committed history)
+    T(u)_ij    = sum_K sum_q w_q B_i(x_q) : C_alg(x_q) : B_j(x_q)                   (4.36)-(4.37)
+
+``formulation``:
+
+* ``"bbar"`` (default, locking free for Q1): the mean-dilatation B-bar strain (Hughes 1980,
+  Simo-Hughes Section 4.4) eps_bar = eps - 1/3 (div u) 1 + 1/3 <div u>_K 1, <.>_K the
+  element mean.  Plastic flow is isochoric, and fully integrated Q1 locks under it (too
+  stiff); B-bar does not.  In plane strain eps_bar_33 = 1/3 (<div u>_K - div u) is in
+  general not zero; it is carried with the full 3 x 3 tensors.  On P1 triangles (constant
+  strain) B-bar is the standard strain (P1 still locks in the plastic limit; use Q1).
+* ``"full"``: the standard strain, fully integrated (2 x 2 Gauss on Q1, 1 point on P1);
+  for the comparison curves.
+
+The body protocol of the contact problems (:mod:`hpfebe.contact.bodies`):
+``internal_force(u) -> (f_int, tangent)`` is a pure function of u and the *committed*
+history (trial return map), ``commit(u)`` makes the state at u the committed history (call
+it only after a load step converged); a failed, cut load step therefore restarts from the
+committed state automatically.  :class:`PlasticFEBody` wraps the body as a contact
+:class:`~hpfebe.contact.bodies.FEBody` (kind "FE", segments, traces, dofs ...).
+
+:class:`DisplacementSteps` is the :class:`hpfebe.nonlinear.LoadStep` of a body alone under
+prescribed displacements and loads (no contact), for :func:`hpfebe.nonlinear.load_path`.
+"""
+
+from __future__ import annotations
+
+
+import numpy as np
+import scipy.sparse as sp
+import scipy.sparse.linalg as spla
+from skfem import Basis, ElementQuad1, ElementTriP1, ElementVector, MeshQuad, MeshTri
+
+from ..nonlinear import Iterate, SingularStep
+from .elasticity import ElasticBody
+from .meshes import FEDomain
+from .plasticity import J2Material, J2State, dev, return_map, tensor_norm, TANGENTS
+
+FORMULATIONS = ("bbar", "full")
+
+
+class ElastoPlasticFE:
+    """J2 elastoplastic P1/Q1 body.  ``mesh`` (labelled skfem MeshTri/MeshQuad or
+    FEDomain), ``material`` (:class:`J2Material`), ``formulation`` ("bbar" or "full"),
+    ``tangent`` ("algorithmic" or "continuum", the tangent returned by internal_force)."""
+
+    def __init__(self, mesh, material: J2Material, formulation: str = "bbar",
+                 tangent: str = "algorithmic"):
+        if isinstance(mesh, FEDomain):
+            mesh = mesh.mesh
+        if not isinstance(material, J2Material):
+            raise ValueError(f"material must be a J2Material, got {type(material).__name__}")
+        if formulation not in FORMULATIONS:
+            raise ValueError(f"formulation must be one of {FORMULATIONS}, got {formulation!r}")
+        if tangent not in TANGENTS:
+            raise ValueError(f"tangent must be one of {TANGENTS}, got {tangent!r}")
+        if isinstance(mesh, MeshQuad):
+            elem, order = ElementQuad1(), 2
+        elif isinstance(mesh, MeshTri):
+            elem, order = ElementTriP1(), 1
+        else:
+            raise ValueError(f"mesh must be a skfem MeshTri or MeshQuad, got {type(mesh).__name__}")
+        self.material, self.formulation, self.tangent = material, formulation, tangent
+        self.elastic = ElasticBody(mesh, material.E, material.nu, "strain")
+        self.mesh = mesh
+        self.basis = Basis(mesh, ElementVector(elem), intorder=order)
+        self.dx = self.basis.dx                                   # (nel, nq)
+        self.nel, self.nq = self.dx.shape
+        self.B = self._strain_operator()                          # (nel, nq, nloc, 9)
+        dofs = self.basis.element_dofs                            # (nloc, nel)
+        self.element_dofs = dofs
+        nloc = dofs.shape[0]
+        self._rows = np.repeat(dofs.T, nloc, axis=1).ravel()
+        self._cols = np.tile(dofs.T, (1, nloc)).ravel()
+        self.committed = J2State.zeros(self.nel * self.nq)
+        self.sigma = np.zeros((self.nel * self.nq, 3, 3))          # committed stress
+        self.K = self._assemble(np.broadcast_to(material.elastic_tangent().reshape(9, 9),
+                                                (self.nel, self.nq, 9, 9)))
+        self._cache = None
+
+    # ------------------------------------------------------------------ kinematics
+    @property
+    def ndofs(self) -> int:
+        return self.basis.N
+
+    @property
+    def n_points(self) -> int:
+        return self.nel * self.nq
+
+    def _strain_operator(self) -> np.ndarray:
+        """(nel, nq, nloc, 3, 3) -> reshaped (nel, nq, nloc, 9): the (B-bar) strain of each
+        local basis function at each quadrature point, plane strain embedded in 3 x 3."""
+        grads = np.stack([phi[0].grad for phi in self.basis.basis])   # (nloc, 2, 2, nel, nq)
+        g = np.moveaxis(grads, (3, 4), (0, 1))                      # (nel, nq, nloc, 2, 2)
+        B = np.zeros(g.shape[:3] + (3, 3))
+        B[..., :2, :2] = 0.5 * (g + np.swapaxes(g, -1, -2))
+        if self.formulation == "bbar":
+            div = g[..., 0, 0] + g[..., 1, 1]                        # (nel, nq, nloc)
+            mean = np.einsum("eqi,eq->ei", div, self.dx) / self.dx.sum(axis=1)[:, None]
+            B += ((mean[:, None, :] - div) / 3.0)[..., None, None] * np.eye(3)
+        return B.reshape(B.shape[:3] + (9,))
+
+    def strain(self, u: np.ndarray) -> np.ndarray:
+        """(nel * nq, 3, 3) (B-bar) strain of the dof vector u at the quadrature points."""
+        u = np.asarray(u, dtype=float)
+        if u.shape != (self.ndofs,):
+            raise ValueError(f"u must have shape ({self.ndofs},), got {u.shape}")
+        ue = u[self.element_dofs].T                                 # (nel, nloc)
+        eps = np.einsum("eqia,ei->eqa", self.B, ue)
+        return eps.reshape(-1, 3, 3)
+
+    def _assemble(self, C: np.ndarray) -> sp.csr_matrix:
+        """sum_K sum_q w_q B^T C B with C (nel, nq, 9, 9)."""
+        CB = C @ np.swapaxes(self.B, -1, -2)                        # (nel, nq, 9, nloc)
+        BCB = self.B @ CB                                           # (nel, nq, nloc, nloc)
+        Ke = np.einsum("eqij,eq->eij", BCB, self.dx)
+        A = sp.coo_matrix((Ke.ravel(), (self._rows, self._cols)), shape=(self.ndofs,) * 2)
+        return A.tocsr()
+
+    def _force(self, sigma: np.ndarray) -> np.ndarray:
+        s = sigma.reshape(self.nel, self.nq, 9)
+        fe = np.einsum("eqia,eqa,eq->ei", self.B, s, self.dx)
+        return np.bincount(self.element_dofs.T.ravel(), fe.ravel(), minlength=self.ndofs)
+
+    # ------------------------------------------------------------------ protocol
+    def response(self, u: np.ndarray, tangent: str | None = None):
+        """The return map at u from the committed history: (f_int, tangent matrix,
+        :class:`~hpfebe.fem.plasticity.ReturnMap`)."""
+        key = np.asarray(u, dtype=float)
+        tg = self.tangent if tangent is None else tangent
+        if self._cache is not None and self._cache[1] == tg and \
+                np.array_equal(self._cache[0], key):
+            return self._cache[2]
+        rm = return_map(self.material, self.strain(key), self.committed, tg)
+        f = self._force(rm.sigma)
+        T = self._assemble(rm.tangent.reshape(self.nel, self.nq, 9, 9))
+        self._cache = (key.copy(), tg, (f, T, rm))
+        return f, T, rm
+
+    def internal_force(self, u: np.ndarray):
+        """(f_int(u), algorithmic tangent) from the committed history (pure in u)."""
+        f, T, _ = self.response(u)
+        return f, T
+
+    def commit(self, u: np.ndarray) -> None:
+        """The state at u becomes the committed history (after a converged load step)."""
+        _, _, rm = self.response(u)
+        self.committed = rm.state.copy()
+        self.sigma = rm.sigma.copy()
+        self._cache = None
+
+    # ------------------------------------------------------------------ post-processing
+    def committed_force(self) -> np.ndarray:
+        """f_int of the committed stress (the reactions on Dirichlet dofs)."""
+        return self._force(self.sigma)
+
+    def fields(self) -> dict:
+        """Committed fields per quadrature point, (nel, nq): ||eps_p||, ||dev sigma||,
+        alpha, and the element means (nel,) under the keys ``*_mean``."""
+        out = {"eps_p_norm": tensor_norm(self.committed.eps_p),
+               "dev_sigma_norm": tensor_norm(dev(self.sigma)),
+               "alpha": self.committed.alpha}
+        w = self.dx / self.dx.sum(axis=1, keepdims=True)
+        for k in list(out):
+            v = out[k].reshape(self.nel, self.nq)
+            out[k] = v
+            out[k + "_mean"] = (v * w).sum(axis=1)
+        return out
+
+    def elements_at(self, point) -> np.ndarray:
+        """Indices of the elements whose closure contains ``point`` (one inside an
+        element, two on an edge, up to four at a vertex; ValueError if outside)."""
+        p = np.asarray(point, dtype=float).reshape(2)
+        d = 1e-9 * float(np.ptp(self.mesh.p, axis=1).max())
+        off = np.array([[d, d], [d, -d], [-d, d], [-d, -d]])
+        x, y = p[0] + off[:, 0], p[1] + off[:, 1]
+        try:
+            e = np.asarray(self.mesh.element_finder()(x, y))
+        except ValueError:
+            e = np.array([-1])
+        e = np.unique(e[e >= 0])
+        if e.size == 0:
+            raise ValueError(f"point must lie in the body, got {tuple(p)!r}")
+        return e
+
+    def value_at(self, key: str, point) -> float:
+        """The committed field ``key`` (see :meth:`fields`) at ``point``: its element
+        mean, averaged over the elements that touch the point."""
+        f = self.fields()
+        if key not in f or key.endswith("_mean"):
+            raise ValueError(f"key must be one of {sorted(k for k in f if '_mean' not in k)}, "
+                             f"got {key!r}")
+        return float(f[key + "_mean"][self.elements_at(point)].mean())
+
+
+class DisplacementSteps:
+    """Load steps of one body alone (:class:`hpfebe.nonlinear.LoadStep`): at load factor
+    lam the dofs ``fixed`` are prescribed to lam * ``values`` and the external load is
+    lam * ``f_ext``; residual R = f_int(u) - lam f_ext on the free dofs, merit 1/2 |R|^2,
+    force scale max |f_int| (reactions included); each step starts from the secant
+    extrapolation of the last two converged states (``extrapolate``).  ``body``: an
+    object with ndofs, internal_force, commit.  ``history`` collects (lam, SolverInfo)
+    of every attempt."""
+
+    def __init__(self, body, fixed, values, f_ext=None, extrapolate: bool = True):
+        self.body = body
+        self.extrapolate = bool(extrapolate)
+        self._last = None
+        n = body.ndofs
+        self.fixed = np.asarray(fixed, dtype=np.int64)
+        self.values = np.broadcast_to(np.asarray(values, dtype=float), self.fixed.shape).copy()
+        if self.fixed.size and (self.fixed.min() < 0 or self.fixed.max() >= n):
+            raise ValueError(f"fixed dofs must lie in [0, {n}), got {self.fixed.min()}.."
+                             f"{self.fixed.max()}")
+        self.f_ext = np.zeros(n) if f_ext is None else np.asarray(f_ext, dtype=float)
+        if self.f_ext.shape != (n,):
+            raise ValueError(f"f_ext must have shape ({n},), got {self.f_ext.shape}")
+        self.free = np.setdiff1d(np.arange(n), self.fixed)
+        self.lam = 0.0
+        self.history = []
+
+    # LoadStep
+    def problem(self, lam: float):
+        self.lam = float(lam)
+        return self
+
+    def start(self, x: np.ndarray, lam: float) -> np.ndarray:
+        """The committed x, extrapolated linearly from the last converged increment if
+        ``extrapolate`` (secant predictor), with the prescribed values at lam."""
+        x = np.array(x, dtype=float)
+        if self.extrapolate and self._last is not None:
+            (x0, l0), (x1, l1) = self._last
+            if l1 > l0 and np.array_equal(x1, x):
+                x = x + (lam - l1) / (l1 - l0) * (x1 - x0)
+        x[self.fixed] = lam * self.values
+        return x
+
+    def commit(self, it: Iterate) -> None:
+        self.body.commit(it.x)
+        prev = (np.zeros_like(it.x), 0.0) if self._last is None else self._last[1]
+        self._last = (prev, (it.x.copy(), self.lam))
+
+    def record(self, it: Iterate, info) -> None:
+        self.history.append((self.lam, info))
+
+    # NewtonProblem
+    def evaluate(self, x: np.ndarray) -> Iterate:
+        f, T = self.body.internal_force(x)
+        r = f[self.free] - self.lam * self.f_ext[self.free]
+        scale = max(float(np.abs(f).max(initial=0.0)),
+                    float(np.abs(self.lam * self.f_ext).max(initial=0.0)), 1e-300)
+        return Iterate(x, r, 0.5 * float(r @ r), scale, None, T)
+
+    def slope(self, it: Iterate, dx: np.ndarray) -> float:
+        return -2.0 * it.merit
+
+    def step(self, it: Iterate) -> np.ndarray:
+        A = it.data[self.free][:, self.free].tocsc()
+        try:
+            d = spla.spsolve(A, -it.residual)
+        except RuntimeError as e:                                   # singular factor
+            raise SingularStep(f"tangent singular: {e}") from None
+        if not np.all(np.isfinite(d)):
+            raise SingularStep("tangent singular: non-finite Newton step")
+        dx = np.zeros_like(it.x)
+        dx[self.free] = d
+        return dx
