@@ -233,15 +233,21 @@ class MortarContact:
     normal : callable (m, 2) points -> (m, 2) outward unit normals of body 1 on
         Gamma^1_C (default: the mean of the adjacent element normals)
     label : contact label of both meshes; axis : pairing parameter of the mortar
+    gap : callable (m, 2) points of Gamma^1_C -> (m,) initial gap (default: the
+        distance along n to Gamma^2_C, :func:`ray_gap`)
+    test_space : "full" (test with all of X^1_hp, Phi^1 = D^-1 B Phi^2 as printed in
+        (4.87)) or "mortar" (the mortar space M^1_hp of (4.49) with end-point matching,
+        (4.50)); see :class:`hpfebe.coupling.mortar.MortarProjection`
     """
 
     def __init__(self, bem1: LameBEM, bem2: LameBEM, dirichlet1, dirichlet2, F: float,
-                 normal=None, label: str = "C", axis=(1.0, 0.0)):
+                 normal=None, label: str = "C", axis=(1.0, 0.0), test_space: str = "full",
+                 gap=None):
         if not np.isfinite(F) or F < 0:
             raise ValueError(f"F must be >= 0, got {F!r}")
         self.bem1, self.bem2, self.F = bem1, bem2, float(F)
         self.mortar = MortarProjection(bem1.mesh, bem2.mesh, label, label, axis,
-                                       bem1.V_space, bem2.V_space)
+                                       bem1.V_space, bem2.V_space, test_space)
         m = self.mortar
         self.c1 = np.column_stack([2 * m.dofs1, 2 * m.dofs1 + 1]).ravel()
         self.c2 = np.column_stack([2 * m.dofs2, 2 * m.dofs2 + 1]).ravel()
@@ -260,7 +266,8 @@ class MortarContact:
         self.n = nrm / np.linalg.norm(nrm, axis=1)[:, None]
         self._normal_fn = normal
         self.t = np.column_stack([-self.n[:, 1], self.n[:, 0]])
-        self.gap = ray_gap(self.points, self.n, bem2.mesh, label)
+        self._gap_fn = gap
+        self.gap = self.gap_at(self.points, self.n)
         self.w = self._lobatto_weights(bem1.mesh, bem1.V_space, m.dofs1, label)
         # rotation to (U_n, U_t) at the contact nodes: x = R u_c
         R = np.zeros((2 * nc, 2 * nc))
@@ -321,6 +328,16 @@ class MortarContact:
             np.add.at(w, d.ravel(), (0.5 * mesh.lengths[e][:, None] * wg[None, :]).ravel())
         return w[dofs]
 
+    def gap_at(self, x, normals) -> np.ndarray:
+        """Initial gap at points x of Gamma^1_C: the scene's gap function, or the distance
+        along ``normals`` to Gamma^2_C (+inf where the ray misses it)."""
+        if self._gap_fn is None:
+            return ray_gap(x, normals, self.bem2.mesh, "C")
+        g = np.asarray(self._gap_fn(np.asarray(x, dtype=float)), dtype=float)
+        if g.shape != (len(x),) or np.any(np.isnan(g)):
+            raise ValueError(f"gap must return {len(x)} finite values, got shape {g.shape}")
+        return g
+
     def _normal(self, x) -> np.ndarray:
         """Unit normal of body 1 at points x of Gamma^1_C (the scene's, or the element's)."""
         if self._normal_fn is not None:
@@ -346,6 +363,18 @@ class MortarContact:
             self._rho_crit = 2.0 / (self.F ** 2 * np.linalg.eigvalsh(0.5 * (T + T.T))[-1])
         return float(self._rho_crit)
 
+    def _rho_bound(self, rho: float, relative: bool, bound) -> float:
+        """The Uzawa step for a nodal friction bound s (Coulomb in DtN): rho itself, or
+        rho / (s-weighted largest eigenvalue) as :attr:`rho_crit` with F -> diag(s)."""
+        if not relative:
+            return float(rho)
+        if not hasattr(self, "_Ctt"):
+            self._Ctt = np.linalg.inv(self.A)[self.nc:, self.nc:]
+        sw = np.sqrt(self.w) * np.asarray(bound, dtype=float)
+        T = sw[:, None] * self._Ctt * sw[None, :]
+        lmax = np.linalg.eigvalsh(0.5 * (T + T.T))[-1]
+        return float(rho) / lmax if lmax > 0 else float(rho)
+
     def rho_step(self, rho: float, relative: bool) -> float:
         """The Uzawa step used: ``rho`` itself, or rho * rho_crit / 2 when ``relative``
         (rho = 1 is then the step with the fastest contraction of the stiffest mode)."""
@@ -361,33 +390,37 @@ class MortarContact:
         v = np.asarray(v).reshape(self.nc, 2)
         return np.sum(v * self.n, axis=1), np.sum(v * self.t, axis=1)
 
-    def contact_qp(self, Q, lam, x0=None, tol: float = 1e-11):
+    def contact_qp(self, Q, lam, x0=None, tol: float = 1e-11, bound=None):
         """Algorithm 4.4 step 2: frictionless contact of body 1 against the obstacle Q
-        with the friction load F w lambda, by projected CG.  Returns (x, info)."""
+        with the friction load F w lambda (``bound``: a nodal friction bound replacing F,
+        e.g. mu_f p_n), by projected CG.  Returns (x, info)."""
         Qn, _ = self.frame(Q)
         rhs = self.b.copy()
-        rhs[self.nc:] -= self.F * self.w * lam
+        F = self.F if bound is None else np.asarray(bound, dtype=float)
+        rhs[self.nc:] -= F * self.w * lam
         upper = np.concatenate([self.gap + Qn, np.full(self.nc, np.inf)])
         return projected_cg(self.A, rhs, upper, x0=x0, tol=tol)
 
     def uzawa(self, Q, rho: float = 1.0, tol: float = 1e-6, max_iter: int = 2000,
-              lam0=None, x0=None, cg_tol: float = 1e-11):
+              lam0=None, x0=None, cg_tol: float = 1e-11, bound=None):
         """Algorithm 4.4 (Uzawa for given friction) against the obstacle Q:
         lambda_{m+1} = P_Lambda(lambda_m + rho F (U_t - Q_t)), stop when
         ||lambda_m - lambda_{m-1}|| <= TOL_U ||lambda_m||.  Returns (x, lambda, info);
-        x = (U_n, U_t) at the contact nodes for the returned lambda."""
+        x = (U_n, U_t) at the contact nodes for the returned lambda.  ``bound``: nodal
+        friction bound s_j replacing F (lambda_j += rho s_j (U_t - Q_t)_j)."""
         _check_pos("rho", rho)
+        F = self.F if bound is None else np.asarray(bound, dtype=float)
         _, Qt = self.frame(Q)
         lam0 = np.zeros(self.nc) if lam0 is None else np.asarray(lam0, dtype=float)
         state = {"x": x0}
 
         def update(lam):
-            x, info = self.contact_qp(Q, lam, state["x"], cg_tol)
+            x, info = self.contact_qp(Q, lam, state["x"], cg_tol, bound)
             state["x"] = x
-            return np.clip(lam + rho * self.F * (x[self.nc:] - Qt), -1.0, 1.0), info
+            return np.clip(lam + rho * F * (x[self.nc:] - Qt), -1.0, 1.0), info
 
         lam, info = fixed_point(update, lam0, tol, max_iter, norm=2)
-        x, qinfo = self.contact_qp(Q, lam, state["x"], cg_tol)
+        x, qinfo = self.contact_qp(Q, lam, state["x"], cg_tol, bound)
         if not qinfo.converged and info.converged:
             info.converged, info.reason = False, f"final QP: {qinfo.reason}"
         return x, lam, info
@@ -396,7 +429,8 @@ class MortarContact:
     def dtn(self, omega_D: float, omega_N: float, rho: float = 1.0, tol: float = 1e-6,
             tol_U: float = 1e-6, max_iter: int = 200, max_uzawa: int = 2000,
             divergence: float = 1e6, rho_relative: bool = True,
-            aitken: bool = False) -> MortarSolution:
+            aitken: bool = False, friction: str = "tresca",
+            transfer: str = "functional") -> MortarSolution:
         """Algorithm 4.3 (Dirichlet-to-Neumann) with damping omega_D, omega_N in (0, 1]:
 
         2. S2 U2 = L2 - P_k (Neumann problem of body 2; P_k = the transferred contact
@@ -411,18 +445,35 @@ class MortarContact:
         iteration.  Non-convergence (cap, growth, NaN) is reported in ``info.reason``.
         ``rho_relative``: the Uzawa step is rho * rho_crit / 2 (:meth:`rho_step`).
 
+        ``transfer``: "functional" - R1 and P are functionals (residual vectors), step 6
+        as above (consistent: action = reaction); "function" - the literal reading of
+        steps 5, 6 and (4.88) with R1 in X^1_hp and P in X^2_hp *functions*: R1 = D^-1 r1
+        (the L2 Riesz representative of the residual r1), P_k+1 = (1 - omega_N) P_k +
+        omega_N B^T D^-T R1 (coefficients) and the load of step 2 <P_k, W^2> = M2 P_k.
+        ``friction``: "tresca" - the bound F of j (given friction, (4.55)); "coulomb" -
+        the nodal bound F p_n with p_n = max(0, -R1_n / w) of the previous DtN iteration
+        (0 in the first one).
+
         ``aitken`` (beyond the thesis): step 6 with Aitken's dynamic relaxation of the
         Neumann damping, P_k+1 = P_k + w_k r_k with r_k = B^T D^-T R1 - P_k,
         w_k = -w_k-1 (r_k-1 . (r_k - r_k-1)) / |r_k - r_k-1|^2 (Irons-Tuck / Kuettler-Wall),
         w_1 = omega_N; omega_D damping of step 3 as given."""
         _check_omega("omega_D", omega_D)
         _check_omega("omega_N", omega_N)
+        if friction not in ("tresca", "coulomb"):
+            raise ValueError(f"friction must be 'tresca' or 'coulomb', got {friction!r}")
+        if transfer not in ("functional", "function"):
+            raise ValueError(f"transfer must be 'functional' or 'function', got "
+                             f"{transfer!r}")
+        rho_in = rho
         rho = self.rho_step(rho, rho_relative)
         m, b2 = self.mortar, self.body2
-        st = dict(Q=np.zeros(2 * self.nc), lam=np.zeros(self.nc), x=None)
+        st = dict(Q=np.zeros(2 * self.nc), lam=np.zeros(self.nc), x=None, bound=None)
+        load2 = m.pair2 if transfer == "function" else (lambda P: P)
+        to_P = (lambda R1: m.adjoint(m.riesz(R1))) if transfer == "function" else m.adjoint
 
         def neumann(P):
-            u2c = b2.solve(-P[b2.cpos])
+            u2c = b2.solve(-load2(P)[b2.cpos])
             return u2c, b2.expand(u2c)[self.c2]
 
         st.update(r=None, w=float(omega_N))
@@ -430,10 +481,15 @@ class MortarContact:
         def update(P):
             _, u2 = neumann(P)
             Q = (1.0 - omega_D) * st["Q"] + omega_D * m.project(u2)
-            x, lam, info = self.uzawa(Q, rho, tol_U, max_uzawa, st["lam"], st["x"])
+            rho_k = rho if st["bound"] is None else self._rho_bound(rho_in, rho_relative,
+                                                                     st["bound"])
+            x, lam, info = self.uzawa(Q, rho_k, tol_U, max_uzawa, st["lam"], st["x"],
+                                      bound=st["bound"])
             st.update(Q=Q, lam=lam, x=x)
             R1 = self.body1.reaction(self.R.T @ x)
-            r = m.adjoint(R1) - P
+            if friction == "coulomb":
+                st["bound"] = self.F * np.maximum(0.0, -self.frame(R1)[0] / self.w)
+            r = to_P(R1) - P
             if aitken and st["r"] is not None:
                 dr = r - st["r"]
                 den = dr @ dr
@@ -619,14 +675,27 @@ class MortarContact:
 
 # --------------------------------------------------------------------------- scene
 def model_meshes(n1: int = 16, n2: int = 12, p1: int = 2, p2: int = 2,
-                 radius: float = 5.05, L: float = 2.0):
+                 radius: float = 5.05, L: float = 2.0, side_depth: float = 2.0,
+                 geometry: str = "arc"):
     """Boundary meshes of the model problem of Section 4.3.4 (see :func:`model_problem`)
-    and the radial normal of the arc: (mesh1, mesh2, normal)."""
+    and the normal of Gamma^1_C: (mesh1, mesh2, normal).
+
+    ``geometry``: "arc" - Gamma^1_C is the polygon of the circular arc (nodes on the
+    circle), normal = radial direction; "flat" - body 1 is the rectangle [-1,1] x [0,2],
+    Gamma^1_C = [-1,1] x {0} (Section 4.3.1: Gamma_C a straight segment, the bodies
+    initially in contact) and the arc enters only through the initial gap
+    :func:`model_gap` measured along the normal (0, -1) of Gamma^1_C.
+
+    ``side_depth``: Gamma^2_D on the vertical sides of body 2 is {-1,1} x [-side_depth, 0]
+    (2 = the whole sides; the thesis prints {-1,1} x [-1,0], i.e. 1, with
+    Gamma^2_N = empty); below it the sides are traction free (label "N")."""
     for name, v in (("n1", n1), ("n2", n2), ("p1", p1), ("p2", p2)):
         if int(v) != v or v < 1:
             raise ValueError(f"{name} must be a positive integer, got {v!r}")
     if radius <= 1.0:
         raise ValueError(f"radius must exceed 1, got {radius!r}")
+    if geometry not in ("arc", "flat"):
+        raise ValueError(f"geometry must be 'arc' or 'flat', got {geometry!r}")
     yc = radius                                       # centre (0, R): arc through (0, 0)
     half = np.arcsin(1.0 / radius)
     ang = np.linspace(-half, half, int(n1) + 1)
@@ -637,30 +706,65 @@ def model_meshes(n1: int = 16, n2: int = 12, p1: int = 2, p2: int = 2,
     verts = np.vstack([arc, [[1.0, 2.0], [-1.0, 2.0]]])
     n_sides = [1] * int(n1) + [nside, int(np.ceil(2.0 / h1 - 1e-9)), nside]
     labels = ["C"] * int(n1) + ["N", "D", "N"]
+    if geometry == "flat":
+        ns = int(np.ceil(2.0 / h1 - 1e-9))
+        verts = np.array([[-1.0, 0.0], [1.0, 0.0], [1.0, 2.0], [-1.0, 2.0]])
+        n_sides, labels = [int(n1), ns, ns, ns], ["C", "N", "D", "N"]
     mesh1 = BoundaryMesh.polygon(verts, n=n_sides, labels=labels, p=int(p1))
+    if not (np.isfinite(side_depth) and 0.0 < side_depth <= 2.0):
+        raise ValueError(f"side_depth must lie in (0, 2], got {side_depth!r}")
     k2 = int(np.ceil(2.0 / h2 - 1e-9))
-    mesh2 = BoundaryMesh.polygon([(-1, -2), (1, -2), (1, 0), (-1, 0)], n=[k2, k2, int(n2), k2],
-                                 labels=["D", "D", "C", "D"], p=int(p2))
+    if side_depth >= 2.0:
+        mesh2 = BoundaryMesh.polygon([(-1, -2), (1, -2), (1, 0), (-1, 0)],
+                                     n=[k2, k2, int(n2), k2], labels=["D", "D", "C", "D"],
+                                     p=int(p2))
+    else:
+        kd = int(np.ceil(side_depth / h2 - 1e-9))
+        kn = int(np.ceil((2.0 - side_depth) / h2 - 1e-9))
+        d = float(side_depth)
+        mesh2 = BoundaryMesh.polygon([(-1, -2), (1, -2), (1, -d), (1, 0), (-1, 0), (-1, -d)],
+                                     n=[k2, kn, kd, int(n2), kd, kn],
+                                     labels=["D", "N", "D", "C", "D", "N"], p=int(p2))
 
     def normal(x):
         d = np.asarray(x, dtype=float) - np.array([0.0, yc])
         return d / np.linalg.norm(d, axis=1)[:, None]
 
-    return mesh1, mesh2, normal
+    def normal_flat(x):
+        return np.tile([0.0, -1.0], (len(x), 1))
+
+    return mesh1, mesh2, (normal if geometry == "arc" else normal_flat)
+
+
+def model_gap(radius: float = 5.05):
+    """The initial gap of the "flat" scene: the height of the arc through (-1, 0.1),
+    (0, 0), (1, 0.1) above Gamma_C, g(x) = R - (R^2 - x^2)^(1/2)."""
+    if radius <= 1.0:
+        raise ValueError(f"radius must exceed 1, got {radius!r}")
+
+    def gap(x):
+        x = np.asarray(x, dtype=float)
+        return radius - np.sqrt(radius ** 2 - np.minimum(x[:, 0] ** 2, radius ** 2))
+
+    return gap
 
 
 def contact_from_meshes(mesh1, mesh2, normal, E: float = 266926.0, nu: float = 0.29,
                         F: float = 0.1, u_top=(0.0, -0.09),
-                        plane: str = "strain") -> MortarContact:
-    """The model problem's boundary conditions on given meshes (e.g. adaptive ones)."""
+                        plane: str = "strain", test_space: str = "full",
+                        gap=None) -> MortarContact:
+    """The model problem's boundary conditions on given meshes (e.g. adaptive ones);
+    ``gap``: the initial gap function (None: measured along the normal to mesh2)."""
     bem1, bem2 = LameBEM(mesh1, E, nu, plane), LameBEM(mesh2, E, nu, plane)
-    return MortarContact(bem1, bem2, ("D", u_top), ("D", (0.0, 0.0)), F, normal=normal)
+    return MortarContact(bem1, bem2, ("D", u_top), ("D", (0.0, 0.0)), F, normal=normal,
+                         test_space=test_space, gap=gap)
 
 
 def model_problem(n1: int = 16, n2: int = 12, p1: int = 2, p2: int = 2,
                   E: float = 266926.0, nu: float = 0.29, F: float = 0.1,
                   u_top=(0.0, -0.09), radius: float = 5.05, plane: str = "strain",
-                  L: float = 2.0) -> MortarContact:
+                  L: float = 2.0, side_depth: float = 2.0,
+                  test_space: str = "full", geometry: str = "arc") -> MortarContact:
     """The model problem of Section 4.3.4 (thesis lines 19474-19530): body 1 bounded by
     Gamma^1_D = [-1,1] x {2} (U = u_top), Gamma^1_N = {-1,1} x [0.1, 2] and the arc
     Gamma^1_C of radius ``radius`` through (-1, 0.1), (0, 0), (1, 0.1); body 2 =
@@ -668,11 +772,15 @@ def model_problem(n1: int = 16, n2: int = 12, p1: int = 2, p2: int = 2,
     Meshes: ``n1`` elements on Gamma^1_C (h1 = L / n1, equal angles), ``n2`` on
     Gamma^2_C (h2 = L / n2), the other sides with ceil(length / h) elements; degrees
     p1, p2 everywhere.  Normals of Gamma^1_C: the radial direction of the circle; gap
-    along it."""
+    along it.  ``geometry="flat"``: Gamma^1_C straight, the arc only as initial gap
+    (:func:`model_meshes`); ``side_depth``: Dirichlet part of body 2's sides;
+    ``test_space``: of the mortar projection (:class:`MortarContact`)."""
     if not np.isfinite(F) or F < 0:
         raise ValueError(f"F must be >= 0, got {F!r}")
-    mesh1, mesh2, normal = model_meshes(n1, n2, p1, p2, radius, L)
-    return contact_from_meshes(mesh1, mesh2, normal, E, nu, F, u_top, plane)
+    mesh1, mesh2, normal = model_meshes(n1, n2, p1, p2, radius, L, side_depth, geometry)
+    gap = model_gap(radius) if geometry == "flat" else None
+    return contact_from_meshes(mesh1, mesh2, normal, E, nu, F, u_top, plane, test_space,
+                               gap)
 
 
 # --------------------------------------------------------------------------- hp
@@ -733,7 +841,7 @@ def mortar_indicators(pr: MortarContact, sol: MortarSolution, nq: int | None = N
     u2[inside] = b2.V_space.evaluate(U2.reshape(-1, 2), e2[inside], t2[inside])
     ps2[inside] = b2.W_space.evaluate(Psi2.reshape(-1, 2), e2[inside], t2[inside])
     nrm = pr._normal(x)
-    g = ray_gap(x, nrm, b2.mesh, "C")
+    g = pr.gap_at(x, nrm)
     pen = np.where(inside & np.isfinite(g), np.maximum(0.0, np.sum((u1 - u2) * nrm, 1) - g), 0.0)
     jump = np.sum((ps1 + ps2) ** 2, 1)
     hp = mesh.lengths / mesh.degrees

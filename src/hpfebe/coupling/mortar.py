@@ -35,7 +35,7 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from ..geometry import BoundaryMesh
-from ..quadrature import gauss_legendre
+from ..quadrature import gauss_legendre, gauss_lobatto
 from ..spaces import ContinuousSpace
 
 
@@ -69,12 +69,18 @@ class MortarProjection:
     space1, space2 : the ContinuousSpace of each mesh (default: built on the mesh)
 
     Attributes: ``dofs1``, ``dofs2`` (scalar contact dofs), ``D`` (n1 x n1), ``B``
-    (n1 x n2), sparse; ``overlap`` = (s_min, s_max) of the common part.
+    (n1 x n2), ``M2`` (n2 x n2, mass matrix of X^2_hp), sparse; ``overlap`` =
+    (s_min, s_max) of the common part; ``P`` the dense projection matrix when
+    ``test_space="mortar"`` (the mortar space M^1_hp of (4.49) with end-point matching,
+    (4.50)), else None (test space all of X^1_hp, D^-1 B as printed in (4.87)).
     """
 
     def __init__(self, mesh1: BoundaryMesh, mesh2: BoundaryMesh, label1: str = "C",
                  label2: str = "C", axis=(1.0, 0.0), space1: ContinuousSpace | None = None,
-                 space2: ContinuousSpace | None = None):
+                 space2: ContinuousSpace | None = None, test_space: str = "full"):
+        if test_space not in ("full", "mortar"):
+            raise ValueError(f"test_space must be 'full' or 'mortar', got {test_space!r}")
+        self.test_space = test_space
         axis = np.asarray(axis, dtype=float)
         if axis.shape != (2,) or not np.isfinite(axis).all() or np.linalg.norm(axis) == 0:
             raise ValueError(f"axis must be a nonzero 2-vector, got {axis!r}")
@@ -107,6 +113,11 @@ class MortarProjection:
         w = (0.5 * mesh1.lengths[e1])[:, None] * wq[None, :]
         D = P1.T @ sp.diags(w.ravel()) @ P1
         self.D = sp.csr_matrix(D[self.dofs1][:, self.dofs1])
+        # M2: mass matrix of X^2_hp on the elements of zone 2 (L2 pairing on Gamma^2_C)
+        t2q = np.broadcast_to(tq, (e2.size, nq))
+        P2 = self.space2.trace_matrix(np.repeat(e2, nq), t2q.ravel())
+        w2 = (0.5 * mesh2.lengths[e2])[:, None] * wq[None, :]
+        self.M2 = sp.csr_matrix((P2.T @ sp.diags(w2.ravel()) @ P2)[self.dofs2][:, self.dofs2])
         # B: on the common refinement of both zones in s, restricted to the overlap
         brk = np.unique(np.concatenate([lo1, hi1, lo2, hi2]))
         brk = brk[(brk >= s_min - tol) & (brk <= s_max + tol)]
@@ -129,6 +140,54 @@ class MortarProjection:
         self._lu = spla.splu(sp.csc_matrix(self.D))
         self.pieces = np.column_stack([a, b])
         self._zones = ((e1, sa1, sb1, lo1, hi1), (e2, sa2, sb2, lo2, hi2))
+        self.P = self._mortar_matrix() if test_space == "mortar" else None
+
+    def _mortar_matrix(self) -> np.ndarray:
+        """The projection (4.50) with the mortar space M^1_hp of (4.49) as test space:
+        pi Phi = Phi at the two end points of Gamma_C (the paired points of Gamma^2_C)
+        and int (Phi - pi Phi) Psi ds = 0 for the Psi of N^1_hp whose degree on the two
+        end elements is p_I - 1.  A Psi of M^1_hp is the N^1_hp function c = E m whose
+        end-point coefficient is the extrapolation of its other GLL values on the end
+        element (Lagrange polynomial of degree p - 1).  Returns the dense matrix of
+        Phi^2 (on dofs2) -> Phi^1 (on dofs1)."""
+        e1, sa1, sb1, lo1, hi1 = self._zones[0]
+        if e1.size < 2:
+            raise ValueError("mesh1: test_space='mortar' needs at least two contact "
+                             "elements on mesh1 (the end elements lose one degree)")
+        pos = -np.ones(self.space1.ndof, dtype=np.int64)
+        pos[self.dofs1] = np.arange(self.dofs1.size)
+        n1 = self.dofs1.size
+        ends, rows = [], []
+        for k, s_end in ((np.argmin(lo1), lo1.min()), (np.argmax(hi1), hi1.max())):
+            el = e1[k]
+            p = int(self.mesh1.degrees[el])
+            tn, _ = gauss_lobatto(p + 1)
+            kb = 0 if abs(sa1[k] - s_end) <= abs(sb1[k] - s_end) else p
+            others = np.array([j for j in range(p + 1) if j != kb])
+            # Lagrange polynomials of degree p - 1 on the other nodes, at t_kb
+            ell = np.array([np.prod([(tn[kb] - tn[m]) / (tn[j] - tn[m])
+                                     for m in others if m != j]) for j in others])
+            d = self.space1.elem_dofs[el]
+            ends.append(pos[d[kb]])
+            rows.append((pos[d[others]], ell))
+        ends = np.array(ends)
+        interior = np.setdiff1d(np.arange(n1), ends)
+        E = np.zeros((n1, interior.size))
+        E[interior, np.arange(interior.size)] = 1.0
+        col = -np.ones(n1, dtype=np.int64)
+        col[interior] = np.arange(interior.size)
+        for eb, (od, ell) in zip(ends, rows):
+            E[eb, col[od]] += ell
+        # end-point values: Phi^2 at the paired points of the overlap's ends
+        s_ends = np.clip([lo1.min(), hi1.max()], *self.overlap)
+        e2, t2, _ = self.locate(s_ends, 2)
+        T = self.space2.trace_matrix(e2, t2).toarray()[:, self.dofs2]
+        D, B = self.D.toarray(), self.B.toarray()
+        K = E.T @ D[:, interior]
+        P = np.zeros((n1, self.dofs2.size))
+        P[ends] = T
+        P[interior] = np.linalg.solve(K, E.T @ (B - D[:, ends] @ T))
+        return P
 
     def parameter(self, points) -> np.ndarray:
         """The pairing parameter s = x . axis of points."""
@@ -170,10 +229,23 @@ class MortarProjection:
     def project(self, phi2) -> np.ndarray:
         """pi^1_hp Phi^2 = D^-1 B Phi^2 (coefficients on ``dofs1``) of Phi^2 given by its
         coefficients on ``dofs2`` (scalar, or interleaved vector)."""
+        if self.P is not None:
+            return self._apply(phi2, self.dofs2.size, lambda V: self.P @ V)
         return self._apply(phi2, self.dofs2.size, lambda V: self._lu.solve(self.B @ V))
+
+    def riesz(self, r1) -> np.ndarray:
+        """The function R in X^1_hp with int R Psi ds = r1(Psi) for all Psi in X^1_hp:
+        D^-1 r1 (scalar or interleaved)."""
+        return self._apply(r1, self.dofs1.size, lambda V: self._lu.solve(V))
+
+    def pair2(self, phi2) -> np.ndarray:
+        """The functional W -> int Phi^2 W ds on X^2_hp of a function Phi^2: M2 Phi^2."""
+        return self._apply(phi2, self.dofs2.size, lambda V: self.M2 @ V)
 
     def adjoint(self, r1) -> np.ndarray:
         """pi^1*_hp R = B^T D^-T R of a functional R on X^1_hp (values on ``dofs1``),
         a functional on X^2_hp (values on ``dofs2``)."""
+        if self.P is not None:
+            return self._apply(r1, self.dofs1.size, lambda V: self.P.T @ V)
         return self._apply(r1, self.dofs1.size,
                            lambda V: self.B.T @ self._lu.solve(V, trans="T"))
