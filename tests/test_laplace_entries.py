@@ -417,6 +417,35 @@ def test_blocks_mixed_degree(name, i, j, pi, pj):
     _check_pair(name, i, j, pi, pj)
 
 
+# ----------------------------------------------- near-touching elements (issue 10)
+# The slit polygon of issue 10: its sides x = 1 and x = 1 + d (elements 3 and 5, length
+# 0.8) face each other at distance d, joined by the element 4 of length d.  Parallel
+# facing pairs are integrated by integration.parallel_block, the tiny element against
+# its neighbours by the adjacent rule; both at 1e-12 as everywhere else.
+SLIT_D = (1e-6, 1e-8)
+
+
+def _slit_geometry(d):
+    nodes = _place([(0, 0), (2, 0), (2, 1), (1 + d, 1), (1 + d, 0.2), (1, 0.2), (1, 1),
+                    (0, 1)], rotate=False)
+    n = len(nodes)
+    return dict(nodes=nodes, pairs=[(3, 5), (5, 3), (3, 4), (4, 5)],
+                segments=np.column_stack([np.arange(n), (np.arange(n) + 1) % n]))
+
+
+for _d in SLIT_D:
+    GEOMS[f"slit-{_d:g}"] = _slit_geometry(_d)    # after PAIRS: own, shorter test list
+
+SLIT_CASES = [pytest.param(f"slit-{d:g}", i, j, pi, pj, id=f"slit{d:g}-{i}{j}-p{pi}x{pj}")
+              for d in SLIT_D for (i, j) in _slit_geometry(d)["pairs"]
+              for pi, pj in ((1, 1), (2, 2), (5, 5), (8, 8), (2, 7))]
+
+
+@pytest.mark.parametrize("name, i, j, pi, pj", SLIT_CASES)
+def test_near_touching_blocks(name, i, j, pi, pj):
+    _check_pair(name, i, j, pi, pj)
+
+
 # ------------------------------------------------------------- checks of the test itself
 def test_geometries_are_the_intended_ones():
     """CCW closed polygons; interior angle at the shared vertex; lengths; gaps."""

@@ -1,56 +1,42 @@
-"""Dense Galerkin assembly of boundary integral operators, parallel over element pairs.
+"""Dense Galerkin assembly of boundary integral operators, parallel over element rows.
 
 One routine, :func:`assemble`, serves every operator: it is specialised by the kernel
 (an id of :mod:`hpfebe.bem.kernels`: Laplace V and K, Lame) and by the test/trial
 spaces.  Each pair of elements is classified (coincident / adjacent / far),
 integrated by the matching function of :mod:`hpfebe.bem.integration` into a local block,
 and scattered.  Rows belong to test elements, so the loop over test elements runs in
-parallel without write conflicts (the test space must be discontinuous: W_hp).
+parallel without write conflicts (the test space must be discontinuous: W_hp): a numba
+parallel loop over chunks of rows (the mirror of the upper triangle and the
+sandwich W = T^T V T run as ``nogil`` kernels on Python threads: no parfor to compile).
 """
 
 from __future__ import annotations
 
 import math
+from concurrent.futures import ThreadPoolExecutor
 from functools import lru_cache
 
+import numba
 import numpy as np
 from numba import njit, prange
 
 from ..quadrature import rule_tables
 from ..spaces import P_MAX, DiscontinuousSpace, eval_basis, gll_tables, n_local
-from .integration import ETA, NMAX, TOL, adjacent_block, coincident_block, far_block
+from .integration import (ETA, NMAX, TOL, adjacent_block, coincident_block, far_block,
+                          nearest_ends)
 from .kernels import kernel_batch
 
 
 @njit(cache=True)
-def _pair_block(kernel, logc, haslog, kp, d, nodes, elements, normals, i, j,
-                kt, pt, kr, pr, gx, gw, lx, lw, gll_x, gll_b, scratch, blk):
-    """Local block of test element i and trial element j into ``blk`` (zeroed here)."""
-    phi, psi, Phi, Psi, Kq, tmp, rxs, rys, wx, ww, stack = scratch
-    mt = n_local(kt, pt) * d
-    mr = n_local(kr, pr) * d
-    for a in range(mt):
-        for b in range(mr):
-            blk[a, b] = 0.0
-    aI, bI = nodes[elements[i, 0]], nodes[elements[i, 1]]
-    aJ, bJ = nodes[elements[j, 0]], nodes[elements[j, 1]]
-    if i == j:
-        coincident_block(kernel, logc, haslog, kp, d, aI, bI, normals[i], kt, pt, kr, pr,
-                         gx, gw, lx, lw, gll_x, gll_b, phi, psi, Kq, rxs, rys, blk)
-        return
-    vI, vJ = -1, -1
-    for q in range(2):
-        for r in range(2):
+def _shared_vertex(elements, i, j):
+    """(q, r) with elements[i, q] == elements[j, r], or (-1, -1).  A function of its own:
+    written inline, the constant -1 gave adjacent_block a second, literal-typed
+    specialisation (3.8 s of compile time)."""
+    for q in range(1, -1, -1):          # the last match in (q, r) order, as always
+        for r in range(1, -1, -1):
             if elements[i, q] == elements[j, r]:
-                vI, vJ = q, r
-    if vI >= 0:
-        adjacent_block(kernel, logc, haslog, kp, d, aI, bI, normals[i], aJ, bJ, normals[j],
-                       vI, vJ, kt, pt, kr, pr, gx, gw, lx, lw, gll_x, gll_b,
-                       phi, psi, Phi, Psi, Kq, tmp, rxs, rys, wx, ww, stack, blk)
-    else:
-        far_block(kernel, logc, haslog, kp, d, aI, bI, normals[i], aJ, bJ, normals[j],
-                  0.0, 1.0, 0.0, 1.0, kt, pt, kr, pr, gx, gw, gll_x, gll_b,
-                  Phi, Psi, Kq, tmp, rxs, rys, stack, blk)
+                return q, r
+    return -1, -1
 
 
 @njit(cache=True)
@@ -80,113 +66,163 @@ def _scatter(blk, dofs_i, dofs_j, mt, mr, d, out):
 
 
 @njit(cache=True, parallel=True)
-def _assemble(kernel, logc, haslog, kp, d, nodes, elements, normals,
-              kt, degt, dofs_t, kr, degr, dofs_r, symmetric,
-              gx, gw, lx, lw, gll_x, gll_b, tab_t, tab_r, thr, out):
+def _assemble_rows(kernel, logc, haslog, kp, d, nodes, elements, normals, L, mid,
+                   kt, degt, dofs_t, kr, degr, dofs_r, symmetric,
+                   gx, gw, lx, lw, gll_x, gll_b, tab_t, tab_r, thr, out, rows, starts):
+    """Rows of the test elements ``rows`` (pairs j >= i only if ``symmetric``) into out,
+    in chunks rows[starts[c]:starts[c+1]] run in parallel, each with its own scratch
+    arrays (allocated once per chunk, not per row: the small-N overhead).  Rows belong to
+    test elements, so chunks never write the same entry.
+
+    ``parallel=True`` costs compile time (the parfor), but numba compiles the parallel
+    loop body with ``noalias`` array arguments, which a plain ``@njit`` function cannot
+    request: the same code as a nogil function run by Python threads (tried for issue
+    14) was 1.4x slower at N = 1024 and up to 1.9x at N = 4096."""
     ne = elements.shape[0]
     nmax = gx.shape[0] - 1
     ntab = tab_t.shape[1] - 1
     pmax = max(degt.max(), degr.max()) + 1
-    dd = d * d
-    L = np.empty(ne)
-    mid = np.empty((ne, 2))
-    for e in range(ne):
-        a, b = nodes[elements[e, 0]], nodes[elements[e, 1]]
-        L[e] = math.hypot(b[0] - a[0], b[1] - a[1])
-        mid[e, 0] = 0.5 * (a[0] + b[0])
-        mid[e, 1] = 0.5 * (a[1] + b[1])
-    for idx in prange(ne):
-        # interleave short and long rows of the triangle (symmetric case) for balance
-        i = idx // 2 if idx % 2 == 0 else ne - 1 - idx // 2
-        scratch = _scratch(nmax, pmax, d)
-        Kq = scratch[4]
-        rxs, rys = scratch[6], scratch[7]
+    for ch in prange(starts.shape[0] - 1):
+        phi, psi, Phi, Psi, Kq, tmp, rxs, rys, wx, ww, stack = _scratch(nmax, pmax, d)
         blk = np.empty((pmax * d, pmax * d))
-        j0 = i if symmetric else 0
-        pt = degt[i]
-        mt = n_local(kt, pt)
-        aI, bI = nodes[elements[i, 0]], nodes[elements[i, 1]]
-        for j in range(j0, ne):
-            pr = degr[j]
-            mr = n_local(kr, pr)
-            # fast path for well separated pairs (most of them): the lower bound
-            # |mid_i - mid_j| - (L_i + L_j)/2 of the distance fixes the Gauss orders via
-            # the thresholds thr[deg, n] of integration._order, basis values are tabulated.
-            # It is written out here instead of calling integration._tensor_rect: a call
-            # with ~30 array arguments per pair cost more than its quadrature (measured:
-            # K for N = 1024, p = 1 went from 0.63 s to 0.19 s)
-            dlow = (math.hypot(mid[i, 0] - mid[j, 0], mid[i, 1] - mid[j, 1])
-                    - 0.5 * (L[i] + L[j]))
-            nx = ntab
-            ny = ntab
-            if dlow >= 2.0 * ETA * max(L[i], L[j]):
-                rx_ = 2.0 * dlow / L[i]
-                ry_ = 2.0 * dlow / L[j]
-                dt_ = pt - 1 if kt == 0 else pt
-                dr_ = pr - 1 if kr == 0 else pr
-                nx = 1
-                while nx < ntab and rx_ < thr[dt_, nx]:
-                    nx += 1
-                ny = 1
-                while ny < ntab and ry_ < thr[dr_, ny]:
-                    ny += 1
-            if nx < ntab and ny < ntab:
-                aJ, bJ = nodes[elements[j, 0]], nodes[elements[j, 1]]
-                for a in range(nx):
-                    x0 = aI[0] + gx[nx, a] * (bI[0] - aI[0])
-                    x1 = aI[1] + gx[nx, a] * (bI[1] - aI[1])
-                    for b in range(ny):
-                        rxs[a * ny + b] = x0 - (aJ[0] + gx[ny, b] * (bJ[0] - aJ[0]))
-                        rys[a * ny + b] = x1 - (aJ[1] + gx[ny, b] * (bJ[1] - aJ[1]))
-                kernel_batch(kernel, rxs, rys, nx * ny, normals[i], normals[j], kp, Kq)
-                for q in range(nx * ny):
-                    w = gw[nx, q // ny] * gw[ny, q % ny] * L[i] * L[j]
-                    if haslog:
-                        lr = 0.5 * math.log(rxs[q] * rxs[q] + rys[q] * rys[q])
-                        for c in range(dd):
-                            Kq[q, c] = w * (Kq[q, c] + logc[c] * lr)
-                    else:
-                        for c in range(dd):
-                            Kq[q, c] *= w
-                # blk[k, l] = sum_a phi_k(a) sum_b Kq[a, b] psi_l(b), in two stages
-                tmp = scratch[5]
-                for a in range(nx):
-                    for l in range(mr):
-                        for c in range(dd):
-                            acc = 0.0
-                            for b in range(ny):
-                                acc += Kq[a * ny + b, c] * tab_r[pr, ny, b, l]
-                            tmp[a, l, c] = acc
-                for k in range(mt):
-                    for l in range(mr):
-                        for c1 in range(d):
-                            for c2 in range(d):
+        for idx in range(starts[ch], starts[ch + 1]):
+            i = rows[idx]
+            j0 = i if symmetric else 0
+            pt = degt[i]
+            mt = n_local(kt, pt)
+            aI, bI = nodes[elements[i, 0]], nodes[elements[i, 1]]
+            for j in range(j0, ne):
+                pr = degr[j]
+                mr = n_local(kr, pr)
+                # fast path for well separated pairs (most of them): the lower bound
+                # |mid_i - mid_j| - (L_i + L_j)/2 of the distance fixes the Gauss orders
+                # via the thresholds thr[deg, n] of integration._order, basis values are
+                # tabulated.  Written out here, not a call of integration.far_block: a
+                # call with ~30 array arguments per pair cost more than its quadrature
+                # (measured: K for N = 1024, p = 1 went from 0.63 s to 0.19 s)
+                dlow = (math.hypot(mid[i, 0] - mid[j, 0], mid[i, 1] - mid[j, 1])
+                        - 0.5 * (L[i] + L[j]))
+                nx = ntab
+                ny = ntab
+                if dlow >= 2.0 * ETA * max(L[i], L[j]):
+                    rx_ = 2.0 * dlow / L[i]
+                    ry_ = 2.0 * dlow / L[j]
+                    dt_ = pt - 1 if kt == 0 else pt
+                    dr_ = pr - 1 if kr == 0 else pr
+                    nx = 1
+                    while nx < ntab and rx_ < thr[dt_, nx]:
+                        nx += 1
+                    ny = 1
+                    while ny < ntab and ry_ < thr[dr_, ny]:
+                        ny += 1
+                if nx < ntab and ny < ntab:
+                    aJ, bJ = nodes[elements[j, 0]], nodes[elements[j, 1]]
+                    for a in range(nx):
+                        x0 = aI[0] + gx[nx, a] * (bI[0] - aI[0])
+                        x1 = aI[1] + gx[nx, a] * (bI[1] - aI[1])
+                        for b in range(ny):
+                            rxs[a * ny + b] = x0 - (aJ[0] + gx[ny, b] * (bJ[0] - aJ[0]))
+                            rys[a * ny + b] = x1 - (aJ[1] + gx[ny, b] * (bJ[1] - aJ[1]))
+                    kernel_batch(kernel, rxs, rys, nx * ny, normals[i], normals[j], kp, Kq)
+                    for q in range(nx * ny):
+                        w = gw[nx, q // ny] * gw[ny, q % ny] * L[i] * L[j]
+                        if haslog:
+                            lr = 0.5 * math.log(rxs[q] * rxs[q] + rys[q] * rys[q])
+                            for c in range(d * d):
+                                Kq[q, c] = w * (Kq[q, c] + logc[c] * lr)
+                        else:
+                            for c in range(d * d):
+                                Kq[q, c] *= w
+                    # blk = sum_a phi_k(a) sum_b Kq[a, b] psi_l(b): integration.contract_block
+                    # written out on the tables (its call here cost 1.3-1.9x at N = 4096)
+                    for a in range(nx):
+                        for l in range(mr):
+                            for c in range(d * d):
                                 acc = 0.0
-                                for a in range(nx):
-                                    acc += tab_t[pt, nx, a, k] * tmp[a, l, c1 * d + c2]
-                                blk[k * d + c1, l * d + c2] = acc
-            else:
-                _pair_block(kernel, logc, haslog, kp, d, nodes, elements, normals, i, j,
-                            kt, pt, kr, pr, gx, gw, lx, lw, gll_x, gll_b, scratch, blk)
-            _scatter(blk, dofs_t[i], dofs_r[j], mt, mr, d, out)
-    if symmetric:
-        # dofs of W_hp grow with the element index, so the pairs j >= i filled the upper
-        # triangle; mirror it in cache-sized tiles (a column-wise mirror inside the pair
-        # loop costs a cache miss per entry once the matrix outgrows the cache)
-        _mirror_upper(out)
+                                for b in range(ny):
+                                    acc += Kq[a * ny + b, c] * tab_r[pr, ny, b, l]
+                                tmp[a, l, c] = acc
+                    for k in range(mt):
+                        for l in range(mr):
+                            for c1 in range(d):
+                                for c2 in range(d):
+                                    acc = 0.0
+                                    for a in range(nx):
+                                        acc += tab_t[pt, nx, a, k] * tmp[a, l, c1 * d + c2]
+                                    blk[k * d + c1, l * d + c2] = acc
+                else:
+                    # near pair: coincident, adjacent or far integration (.integration)
+                    for a in range(mt * d):
+                        for b in range(mr * d):
+                            blk[a, b] = 0.0
+                    aJ, bJ = nodes[elements[j, 0]], nodes[elements[j, 1]]
+                    vI, vJ = _shared_vertex(elements, i, j)
+                    if i == j:
+                        coincident_block(kernel, logc, haslog, kp, d, aI, bI, normals[i],
+                                         kt, pt, kr, pr, gx, gw, lx, lw, gll_x, gll_b,
+                                         phi, psi, Kq, rxs, rys, blk)
+                    elif vI >= 0:
+                        adjacent_block(kernel, logc, haslog, kp, d, aI, bI, normals[i], aJ,
+                                       bJ, normals[j], vI, vJ, kt, pt, kr, pr, gx, gw, lx,
+                                       lw, gll_x, gll_b, phi, psi, Phi, Psi, Kq, tmp, rxs,
+                                       rys, wx, ww, stack, blk)
+                    else:
+                        rI, rJ = nearest_ends(aI, bI, aJ, bJ)
+                        far_block(kernel, logc, haslog, kp, d, aI, bI, normals[i], aJ, bJ,
+                                  normals[j], 0.0, 1.0, 0.0, 1.0, rI, rJ, kt, pt, kr, pr,
+                                  gx, gw, gll_x, gll_b, Phi, Psi, Kq, tmp, rxs, rys, wx, ww,
+                                  stack, blk)
+                _scatter(blk, dofs_t[i], dofs_r[j], mt, mr, d, out)
 
 
-@njit(cache=True, parallel=True)
-def _mirror_upper(A):
-    """A[r, c] = A[c, r] for r > c, tile by tile."""
+@njit(cache=True, nogil=True)
+def _mirror_rows(A, blocks):
+    """A[r, c] = A[c, r] for r > c in the row tiles ``blocks`` (64 rows each), tile by tile:
+    a column-wise mirror costs a cache miss per entry once A outgrows the cache."""
     n = A.shape[0]
     bs = 64
-    nb = (n + bs - 1) // bs
-    for bi in prange(nb):
+    for bi in blocks:
         for bj in range(bi + 1):
             for r in range(bi * bs, min(n, (bi + 1) * bs)):
                 for c in range(bj * bs, min(r, (bj + 1) * bs)):
                     A[r, c] = A[c, r]
+
+
+MIN_PAIRS_PER_THREAD = 4096   # below this many element pairs one thread is faster
+
+
+def _chunk_starts(n: int, work: float) -> np.ndarray:
+    """Boundaries of the row chunks of the parallel loop: one chunk when ``work`` (element
+    pairs) is too small to pay for threads, else 4 per thread."""
+    nt = numba.get_num_threads()
+    nchunks = 1 if nt <= 1 or work < MIN_PAIRS_PER_THREAD * nt else min(n, 4 * nt)
+    return np.linspace(0, n, nchunks + 1).round().astype(np.int64)
+
+
+def _interleaved(n: int) -> np.ndarray:
+    """0, n-1, 1, n-2, ...: short and long rows of a triangle alternate (load balance)."""
+    idx = np.arange(n)
+    return np.where(idx % 2 == 0, idx // 2, n - 1 - idx // 2)
+
+
+def _threaded(fn, args, items: np.ndarray, work: float) -> None:
+    """fn(*args, chunk) over chunks of ``items`` on numba.get_num_threads() threads (the
+    nogil kernels write disjoint rows); one direct call when ``work`` (element pairs) is
+    too small to pay for threads.  NUMBA_NUM_THREADS / numba.set_num_threads pin it."""
+    nt = min(numba.get_num_threads(), len(items))
+    if nt <= 1 or work < MIN_PAIRS_PER_THREAD * nt:
+        fn(*args, items)
+        return
+    # 4 chunks per thread taken dynamically, each a run of the interleaved order
+    chunks = np.array_split(items, 4 * nt)
+    with ThreadPoolExecutor(max_workers=nt) as pool:
+        for f in [pool.submit(fn, *args, c) for c in chunks]:
+            f.result()
+
+
+def _mirror_upper(A: np.ndarray) -> None:
+    nb = (A.shape[0] + 63) // 64
+    _threaded(_mirror_rows, (A,), _interleaved(nb), 0.5 * A.shape[0] ** 2 / 64)
 
 
 NTAB = 12  # far pairs needing fewer Gauss points than this use tabulated basis values
@@ -252,10 +288,21 @@ def assemble(kernel: int, logc, kp, test, trial, d: int = 1,
     kr, degr, dofs_r = _space_arrays(trial)
     out = np.zeros((test.ndof * d, trial.ndof * d))
     pmax = int(mesh.degrees.max())
-    _assemble(kernel, logc, bool(np.any(logc != 0.0)), kp, d, mesh.nodes, mesh.elements,
-              np.ascontiguousarray(mesh.normals), kt, degt, dofs_t, kr, degr, dofs_r,
-              symmetric, gx, gw, lx, lw, gll_x, gll_b, _far_tables(kt, pmax),
-              _far_tables(kr, pmax), _order_thresholds(pmax), out)
+    nodes, elements = mesh.nodes, mesh.elements
+    a, b = nodes[elements[:, 0]], nodes[elements[:, 1]]
+    L = np.hypot(b[:, 0] - a[:, 0], b[:, 1] - a[:, 1])
+    mid = np.ascontiguousarray(0.5 * (a + b))
+    ne = elements.shape[0]
+    args = (kernel, logc, bool(np.any(logc != 0.0)), kp, d, nodes, elements,
+            np.ascontiguousarray(mesh.normals), L, mid, kt, degt, dofs_t, kr, degr, dofs_r,
+            symmetric, gx, gw, lx, lw, gll_x, gll_b, _far_tables(kt, pmax),
+            _far_tables(kr, pmax), _order_thresholds(pmax), out)
+    _assemble_rows(*args, _interleaved(ne),
+                   _chunk_starts(ne, ne * ne * (0.5 if symmetric else 1.0)))
+    if symmetric:
+        # dofs of W_hp grow with the element index, so the pairs j >= i filled the
+        # upper triangle
+        _mirror_upper(out)
     if not np.all(np.isfinite(out)):
         raise FloatingPointError("assembly produced non-finite entries "
                                  "(degenerate geometry or degree too high?)")
@@ -265,30 +312,47 @@ def assemble(kernel: int, logc, kp, test, trial, d: int = 1,
 def local_block(kernel, logc, kp, mesh, i: int, j: int, test_kind: int, trial_kind: int,
                 d: int = 1) -> np.ndarray:
     """Local block of the pair (test element i, trial element j) with basis kinds
-    0 (Legendre, W_hp) or 1 (GLL Lagrange, V_hp) at the elements' degrees; for tests."""
+    0 (Legendre, W_hp) or 1 (GLL Lagrange, V_hp) at the elements' degrees, by the same
+    integration functions as :func:`assemble` uses for near pairs; for tests."""
     gx, gw, lx, lw = rule_tables(NMAX)
     gll_x, gll_b = gll_tables(P_MAX)
     logc = np.ascontiguousarray(np.asarray(logc, dtype=float).reshape(d * d))
     kp = np.ascontiguousarray(np.asarray(kp, dtype=float).reshape(-1))
+    haslog = bool(np.any(logc != 0.0))
     pt, pr = int(mesh.degrees[i]), int(mesh.degrees[j])
     nmax = gx.shape[0] - 1
     pmax = max(pt, pr) + 1
     blk = np.zeros((pmax * d, pmax * d))
-    _pair_block(kernel, logc, bool(np.any(logc != 0.0)), kp, d, mesh.nodes, mesh.elements,
-                np.ascontiguousarray(mesh.normals), i, j, test_kind, pt, trial_kind, pr,
-                gx, gw, lx, lw, gll_x, gll_b, _scratch(nmax, pmax, d), blk)
+    phi, psi, Phi, Psi, Kq, tmp, rxs, rys, wx, ww, stack = _scratch(nmax, pmax, d)
+    normals = np.ascontiguousarray(mesh.normals)
+    elements = mesh.elements
+    aI, bI = mesh.nodes[elements[i, 0]], mesh.nodes[elements[i, 1]]
+    aJ, bJ = mesh.nodes[elements[j, 0]], mesh.nodes[elements[j, 1]]
+    shared = [(q, r) for q in range(2) for r in range(2) if elements[i, q] == elements[j, r]]
+    if i == j:
+        coincident_block(kernel, logc, haslog, kp, d, aI, bI, normals[i], test_kind, pt,
+                         trial_kind, pr, gx, gw, lx, lw, gll_x, gll_b, phi, psi, Kq, rxs, rys,
+                         blk)
+    elif shared:
+        vI, vJ = shared[-1]
+        adjacent_block(kernel, logc, haslog, kp, d, aI, bI, normals[i], aJ, bJ, normals[j],
+                       vI, vJ, test_kind, pt, trial_kind, pr, gx, gw, lx, lw, gll_x, gll_b,
+                       phi, psi, Phi, Psi, Kq, tmp, rxs, rys, wx, ww, stack, blk)
+    else:
+        rI, rJ = nearest_ends(aI, bI, aJ, bJ)
+        far_block(kernel, logc, haslog, kp, d, aI, bI, normals[i], aJ, bJ, normals[j],
+                  0.0, 1.0, 0.0, 1.0, rI, rJ, test_kind, pt, trial_kind, pr, gx, gw, gll_x,
+                  gll_b, Phi, Psi, Kq, tmp, rxs, rys, wx, ww, stack, blk)
     mt = (pt if test_kind == 0 else pt + 1) * d
     mr = (pr if trial_kind == 0 else pr + 1) * d
     return blk[:mt, :mr].copy()
 
 
-
-@njit(cache=True, parallel=True)
-def _sandwich(indptr, indices, data, V, out):
-    """out = R V R^T for R in CSR (rows of R = rows of out); only j >= i, mirrored."""
+@njit(cache=True, nogil=True)
+def _sandwich_rows(indptr, indices, data, V, out, rows):
+    """out[i, j] = out[j, i] = (R V R^T)[i, j] for i in ``rows``, j >= i (R in CSR)."""
     n = out.shape[0]
-    for idx in prange(n):
-        i = idx // 2 if idx % 2 == 0 else n - 1 - idx // 2   # balance the triangle
+    for i in rows:
         for j in range(i, n):
             acc = 0.0
             for a in range(indptr[i], indptr[i + 1]):
@@ -308,5 +372,7 @@ def sandwich(T, V: np.ndarray) -> np.ndarray:
     R = T.T.tocsr()
     R.sort_indices()
     out = np.empty((R.shape[0], R.shape[0]))
-    _sandwich(R.indptr, R.indices, R.data, np.ascontiguousarray(V), out)
+    n = R.shape[0]
+    _threaded(_sandwich_rows, (R.indptr, R.indices, R.data, np.ascontiguousarray(V), out),
+              _interleaved(n), 0.5 * n * n)
     return out

@@ -93,6 +93,26 @@ def kernel_params(lam: float, mu: float, scale: float) -> np.ndarray:
     return kp
 
 
+TINY = 1e-250   # below this c1 or E'/(4 pi) has lost its digits (subnormal products)
+
+
+def _checked_kernel_params(E: float, nu: float, lam: float, mu: float, scale: float):
+    """:func:`kernel_params`, refusing a Young's modulus whose kernel constants overflow
+    or underflow in double precision (c1 ~ 1/E, E' ~ E): otherwise V would come out zero
+    or infinite and the Cholesky factorisation fail with a misleading message."""
+    try:
+        kp = kernel_params(lam, mu, scale)
+    except (ZeroDivisionError, OverflowError):
+        kp = np.full(KP_LAME_SIZE, np.nan)
+    c1, Et = kp[KP_C1], kp[KP_ET]
+    if not (np.all(np.isfinite(kp)) and TINY < c1 < 1 / TINY and TINY < Et < 1 / TINY):
+        raise ValueError(
+            f"E = {E!r} (nu = {nu!r}) is out of the range double precision can handle: "
+            f"the kernel constants overflow/underflow (c1 = {c1!r}, E'/(4 pi) = {Et!r}); "
+            "express E in other units so that it is moderate")
+    return kp
+
+
 def _logc(c: float) -> np.ndarray:
     return np.array([-c, 0.0, 0.0, -c])
 
@@ -134,7 +154,7 @@ class LameBEM(BoundaryOperators):
             scale = 2.0 * mesh.diameter
         super().__init__(mesh, scale, constrained=zero_force)
         self.zero_force = self.constrained
-        self.kp = kernel_params(self.lam, self.mu, self.scale)
+        self.kp = _checked_kernel_params(E, nu, self.lam, self.mu, self.scale)
 
     @property
     def c1(self) -> float:

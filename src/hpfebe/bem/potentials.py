@@ -177,6 +177,11 @@ def evaluate_potential(kid: int, kp, d: int, points, space, coeffs, nout: int | 
     pts = np.ascontiguousarray(np.atleast_2d(np.asarray(points, dtype=float)))
     if pts.ndim != 2 or pts.shape[1] != 2:
         raise ValueError(f"points must have shape (n, 2), got {pts.shape}")
+    bad = ~np.all(np.isfinite(pts), axis=1)
+    if np.any(bad):
+        k = int(np.argmax(bad))
+        raise ValueError(f"points must be finite: point {k} = {tuple(pts[k])} has a "
+                         "non-finite (NaN or inf) coordinate")
     coef = np.ascontiguousarray(np.asarray(coeffs, dtype=float).reshape(-1, d))
     if coef.shape[0] != space.ndof:
         raise ValueError(f"coeffs must have {space.ndof * d} entries, got {coef.size}")

@@ -1,0 +1,96 @@
+"""Cold-cache numba compile times of the BEM kernels, per function and specialisation.
+
+Runs the scene in a fresh Python process with an empty, temporary NUMBA_CACHE_DIR and
+records numba's "numba:compile" events (numba.core.event): one line per compiled
+(function, signature), its own time (nested compiles subtracted), and the wall time of
+each step of the scene.  A second process with the same (now warm) cache gives the
+warm-start times.
+
+    python tools/compile_time.py            # first LaplaceBEM(mesh).V, LameBEM(...).S_hat
+    python tools/compile_time.py --top 40   # more lines
+    python tools/compile_time.py --threads 2
+
+Issue 14 targets: cold (empty cache) under 10 s, warm first call under 0.5 s.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import subprocess
+import sys
+import tempfile
+import textwrap
+
+SCENE = textwrap.dedent("""
+    import json, sys, time
+    t0 = time.perf_counter()
+    import numba.core.event as ev
+    records = []
+    stack = []
+
+    class L(ev.Listener):
+        def on_start(self, event):
+            stack.append([time.perf_counter(), 0.0])
+        def on_end(self, event):
+            t_start, child = stack.pop()
+            total = time.perf_counter() - t_start
+            if stack:
+                stack[-1][1] += total
+            d = event.data["dispatcher"]
+            f = getattr(d, "py_func", None)
+            records.append(dict(name=(f.__module__ + "." + f.__qualname__) if f else str(d),
+                                sig=str(event.data["args"]), self_s=total - child,
+                                total_s=total))
+
+    ev.register("numba:compile", L())
+    from hpfebe import BoundaryMesh
+    from hpfebe.bem import LameBEM, LaplaceBEM
+    steps = {"import": time.perf_counter() - t0}
+    mesh = BoundaryMesh.polygon([(0, 0), (1, 0), (1, 1), (0, 1)], n=2, p=1)
+    t = time.perf_counter(); LaplaceBEM(mesh).V; steps["LaplaceBEM.V"] = time.perf_counter() - t
+    t = time.perf_counter(); LameBEM(mesh, 1.0, 0.3).S_hat
+    steps["LameBEM.S_hat"] = time.perf_counter() - t
+    print(json.dumps(dict(steps=steps, records=records)))
+""")
+
+
+def run(cache_dir: str, threads: int) -> dict:
+    env = dict(os.environ, NUMBA_CACHE_DIR=cache_dir, NUMBA_NUM_THREADS=str(threads))
+    out = subprocess.run([sys.executable, "-c", SCENE], env=env, capture_output=True,
+                         text=True)
+    if out.returncode != 0:
+        sys.exit(f"the scene failed:\n{out.stderr}")
+    return json.loads(out.stdout.strip().splitlines()[-1])
+
+
+def main(argv=None) -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--top", type=int, default=25, help="lines of the per-function table")
+    ap.add_argument("--threads", type=int, default=1, help="NUMBA_NUM_THREADS")
+    args = ap.parse_args(argv)
+    with tempfile.TemporaryDirectory(prefix="numba_cache_") as cache:
+        cold = run(cache, args.threads)
+        warm = run(cache, args.threads)
+    for label, res in (("cold (empty cache)", cold), ("warm (cached)", warm)):
+        s = res["steps"]
+        print(f"{label}: " + ", ".join(f"{k} {v:.2f} s" for k, v in s.items())
+              + f"; total {sum(s.values()):.2f} s")
+    recs = sorted(cold["records"], key=lambda r: -r["self_s"])
+    per_fn: dict[str, list] = {}
+    for r in recs:
+        per_fn.setdefault(r["name"], []).append(r)
+    print(f"\n{len(recs)} compilations of {len(per_fn)} functions, "
+          f"{sum(r['self_s'] for r in recs):.2f} s in all (self time)")
+    print(f"{'self s':>7} {'#sig':>4}  function")
+    rows = sorted(per_fn.items(), key=lambda kv: -sum(r["self_s"] for r in kv[1]))
+    for name, rs in rows[:args.top]:
+        print(f"{sum(r['self_s'] for r in rs):7.2f} {len(rs):4d}  {name}")
+    if warm["records"]:
+        print(f"\nwarm run still compiled {len(warm['records'])} specialisations: "
+              + ", ".join(sorted({r['name'].rsplit('.', 1)[-1] for r in warm['records']})))
+
+
+if __name__ == "__main__":
+    main()
