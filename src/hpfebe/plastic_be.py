@@ -1,0 +1,486 @@
+"""An elastoplastic boundary element body (thesis Section 4.2.4, (4.28)-(4.33),
+Algorithm 4.2): boundary displacement unknowns with the discrete Steklov-Poincare operator
+S_hat of :class:`hpfebe.bem.lame.LameBEM`, the plastic strain piecewise constant on cells
+of the work piece (:class:`hpfebe.fem.newton_potential.CellComplex`), updated from the
+cell-average strain by the J2 return map (:mod:`hpfebe.fem.plasticity`).
+
+Placed between :mod:`hpfebe.bem` and the contact problems: it needs the boundary
+operators, the Newton potential of :mod:`hpfebe.fem.newton_potential` and the J2 return
+map; :class:`PlasticBEBody` (the contact-body wrapper, like
+:class:`hpfebe.contact.bodies.PlasticFEBody`) uses only :mod:`hpfebe.contact.bodies`
+(which does not import this module), so :mod:`hpfebe.contact.stamping` can use it
+without an import cycle.
+
+**The boundary equation (4.29).**  With tau = C : eps_p (in-plane), the weak form of
+div sigma = 0, sigma = C : (eps(u) - eps_p), tested with the elastic extension Phi~ of a
+boundary function Phi (div C eps(Phi~) = 0), is
+
+    <S u, Phi> - G(eps_p, Phi) = <t, Phi>,
+    G(eps_p, Phi) = (C : eps_p, eps(Phi~))_Omega = sum_cells int_{d c} (tau_c n_c) . Phi~ ds,
+
+(divergence theorem cell by cell, tau constant per cell) - the thesis's
+G = -<N(div(C : eps_p)), Phi> + <(C : eps_p) n, Phi>: the cell edges on Gamma give
+<tau n, Phi> (Phi~ = Phi there), the interior edges the Newton-potential part through
+Phi~(y) = (V~ Psi(Phi) - K~ Phi)(y) (Somigliana with the discrete Dirichlet-to-Neumann
+traction Psi, :meth:`LameBEM.representation`).  A uniform eps_p gives exactly
+G = <tau n, Phi>, and u = eps_p x solves S_hat u = G (S_hat reproduces linear fields on
+a polygon), so the uniform initial-strain problem is solved exactly (tested).
+
+**The strain in the cells.**  The return map works with the cell average
+eps_c = |c|^-1 int_{d c} sym(u x n) ds of the strain (one state per cell), u on the cell
+edges from the initial-strain Somigliana identity u = V~ t - K~ u + w (w the Newton
+potential, :func:`newton_operators`; the true traction from the first-kind equation
+<V t, psi> = <(K + M/2) u, psi> - <w, psi>, with the zero-total-force projection of
+LameBEM since t is in equilibrium), i.e. u = Phi~[u] - V~ P <w, .> + w on interior edges
+and the P1 trace on Gamma:
+
+    g_c = A_u u + A_tau tau  (rows 4 c + 2 i + m, g = cell-average grad u),
+    G   = (area-weighted A_u)^T,
+
+so G and the strain map are adjoint by construction.  This matters: with the strain
+evaluated at the centroids instead (a first version), the map eps_p -> -dev sigma / 2 mu
+had eigenvalues down to -0.19 (spurious modes; the explicit update blew up for small
+hardening); with the cell averages its spectrum lies in [0, 1] as for the continuous
+operator (measured, N = 4 punch).
+
+**Algorithm 4.2** (forward Euler in eps_p, backward Euler for contact): the matrix is
+S_hat alone; the plastic strain enters the right-hand side.  ``internal_force(u)``
+returns (S_hat u - G tau(eps_p committed), S_hat): a pure function of u and the committed
+history (the body protocol of :mod:`hpfebe.contact.bodies`), and ``commit(u)`` performs
+the return map per cell (cell-average strain) from the committed state with the strain at u -
+the plastic strain is one load step behind (explicit), so the result depends on the step
+size (tests/test_plastic_be.py measures it).  ``staggered_step`` iterates the update
+within one load step (Algorithm 4.2 step v with eps_p^(k) in b, the fixed point of
+:func:`hpfebe.nonlinear.fixed_point`) - it converges to the implicit solution, linearly
+with a rate near 1 - 2 mu / (2 mu + 2/3 H) ... (slow for small hardening).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import scipy.linalg as sla
+import scipy.sparse as sp
+
+from .bem.lame import LameBEM
+from .geometry import BoundaryMesh
+from .contact.bodies import BEBody
+from .fem.newton_potential import (CellComplex, edge_integrals, initial_stress,
+                                   kelvin_constants, newton_operators)
+from .fem.plasticity import J2Material, J2State, embed_plane, return_map, tensor_norm, dev
+from .nonlinear import fixed_point
+
+GAUSS_EDGE = 4
+SCHEMES = ("explicit", "implicit")
+
+
+# tau_a = sum_ij TAU_SEL[a, i, j] (C : eps_p)_ij, eps = sum_b e_b EPS_SEL[b]
+_TAU_SEL = np.zeros((3, 3, 3))
+_TAU_SEL[0, 0, 0] = _TAU_SEL[1, 1, 1] = _TAU_SEL[2, 0, 1] = 1.0
+_EPS_SEL = np.zeros((3, 3, 3))
+_EPS_SEL[0, 0, 0] = _EPS_SEL[1, 1, 1] = 1.0
+_EPS_SEL[2, 0, 1] = _EPS_SEL[2, 1, 0] = 0.5
+
+
+def _block_diag(D: np.ndarray) -> np.ndarray:
+    """Dense block diagonal matrix of the (n, k, k) blocks D."""
+    n, k, _ = D.shape
+    out = np.zeros((n, k, n, k))
+    out[np.arange(n), :, np.arange(n), :] = D
+    return out.reshape(n * k, n * k)
+
+
+def _graded_rule(levels: int = 4, order: int = 8):
+    """Composite Gauss rule on [0, 1] graded geometrically (ratio 1/4) towards both
+    ends: w on Gamma behaves like r log r at the nodes where interior cell edges meet
+    Gamma, which plain Gauss integrates only to ~1e-5."""
+    left = 0.25 ** np.arange(levels, 0, -1) * 0.5                # 1/2 4^-k
+    br = np.concatenate([[0.0], left, [0.5], 1.0 - left[::-1], [1.0]])
+    gx, gw = np.polynomial.legendre.leggauss(order)
+    a, b = br[:-1, None], br[1:, None]
+    return (a + 0.5 * (gx + 1) * (b - a)).ravel(), (0.5 * gw * (b - a)).ravel()
+
+
+def _match_nodes(points: np.ndarray, nodes: np.ndarray, tol: float) -> np.ndarray:
+    """Index of the BEM node equal to each point (within tol), -1 if none."""
+    d = np.linalg.norm(points[:, None, :] - nodes[None, :, :], axis=-1)
+    j = np.argmin(d, axis=1)
+    return np.where(d[np.arange(len(points)), j] <= tol, j, -1)
+
+
+class ElastoPlasticBE:
+    """J2 elastoplastic BE body.  ``bem``: :class:`LameBEM` of degree 1 (plane strain),
+    ``cells``: :class:`CellComplex` covering the region where plastic strain may appear
+    (the whole work piece or a part of it, its nodes on Gamma coinciding with BEM nodes),
+    ``material``: :class:`J2Material` with the BEM's E and nu."""
+
+    kind = "BE"
+
+    def __init__(self, bem: LameBEM, cells: CellComplex, material: J2Material,
+                 scheme: str = "explicit"):
+        if scheme not in SCHEMES:
+            raise ValueError(f"scheme must be one of {SCHEMES}, got {scheme!r}")
+        self.scheme = scheme
+        if not isinstance(bem, LameBEM):
+            raise ValueError(f"bem must be a LameBEM (2D elasticity), got {type(bem).__name__}")
+        if not isinstance(cells, CellComplex):
+            raise ValueError(f"cells must be a CellComplex, got {type(cells).__name__}")
+        if not isinstance(material, J2Material):
+            raise ValueError(f"material must be a J2Material, got {type(material).__name__}")
+        if bem.plane != "strain":
+            raise ValueError(f"bem must be plane strain (J2 body), got plane={bem.plane!r}")
+        if not np.all(bem.mesh.degrees == 1):
+            raise ValueError("bem must have degree 1 on every element (P1 displacements)")
+        if not (np.isclose(bem.E, material.E) and np.isclose(bem.nu, material.nu)):
+            raise ValueError(f"material (E={material.E}, nu={material.nu}) must have the "
+                             f"bem's E={bem.E}, nu={bem.nu}")
+        self.bem, self.cells, self.material = bem, cells, material
+        self.E, self.nu = material.E, material.nu
+        self.ndofs = 2 * bem.V_space.ndof
+        self.S = bem.S_hat
+        self.K = sp.csr_matrix(self.S)
+        self.points = cells.centroids
+        self._build()
+        self.committed = J2State.zeros(cells.ncells)
+        self.sigma = np.zeros((cells.ncells, 3, 3))
+        self.plastic = np.zeros(cells.ncells, dtype=bool)
+
+    # ------------------------------------------------------------------ operators
+    def _P(self, Y: np.ndarray) -> np.ndarray:
+        """Constrained V^{-1} (zero total force, as LameBEM.Psi) applied to columns Y."""
+        bem = self.bem
+        X = sla.cho_solve(bem.V_cho, Y)
+        if bem.constrained:
+            C = bem.constraints
+            VC = sla.cho_solve(bem.V_cho, C)
+            X = X - VC @ np.linalg.solve(C.T @ VC, C.T @ X)
+        return X
+
+    def _columns(self, fn, n: int, pts: np.ndarray, width: int) -> np.ndarray:
+        """Matrix whose column k is fn(pts, e_k) flattened (one vectorised potential
+        evaluation per basis function)."""
+        out = np.empty((len(pts) * width, n))
+        e = np.zeros(n)
+        for k in range(n):
+            e[k] = 1.0
+            out[:, k] = fn(pts, e).ravel()
+            e[k] = 0.0
+        return out
+
+    def _build(self):
+        """The cell-average displacement gradients g_c = |c|^-1 int_{d c} u (x) n ds
+        (rows 4 c + 2 i + m) as A_u u + A_tau tau, and G = (area-weighted A_u)^T."""
+        bem, cx = self.bem, self.cells
+        mesh = bem.mesh
+        nV, nW = 2 * bem.V_space.ndof, 2 * bem.W_space.ndof
+        zW = np.zeros(nW)
+        nc, nc3 = cx.ncells, 3 * cx.ncells
+        tol = 1e-9 * mesh.diameter
+        # --- cell edges on Gamma (both end nodes BEM nodes joined by a BEM element)
+        ia = _match_nodes(cx.nodes[cx.edges[:, 0]], mesh.nodes, tol)
+        ib = _match_nodes(cx.nodes[cx.edges[:, 1]], mesh.nodes, tol)
+        el = {(int(a), int(b)) for a, b in mesh.elements}
+        on = np.array([(a, b) in el or (b, a) in el for a, b in zip(ia, ib)])
+        on &= (ia >= 0) & (ib >= 0) & cx.boundary_edge
+        if not np.any(on):
+            raise ValueError("cells must share edges with the BEM boundary (no cell edge "
+                             "lies on Gamma: node coordinates do not match)")
+        node_dof = np.full(len(mesh.nodes), -1)
+        node_dof[mesh.elements[:, 0]] = bem.V_space.elem_dofs[:, 0]
+        node_dof[mesh.elements[:, 1]] = bem.V_space.elem_dofs[:, 1]
+        # edge weights: |c|^-1 int_e (.) n_m ds  ->  row factor n_m L_e / |c|
+        fac = (cx.lengths / cx.areas[cx.edge_cell])[:, None] * cx.normals     # (S, 2)
+        A_u = np.zeros((nc, 2, 2, nV))
+        A_tau = np.zeros((nc, 2, 2, nc3))
+        # Gamma edges: the P1 trace, int_e u ds = L/2 (u_A + u_B)
+        e_on = np.flatnonzero(on)
+        for ends in (ia[on], ib[on]):
+            for i in range(2):
+                np.add.at(A_u, (cx.edge_cell[e_on], i, slice(None), 2 * node_dof[ends] + i),
+                          0.5 * fac[e_on])
+        # interior edges: u(y) = Phi~[u](y) - SL(P G_w tau)(y) + w(y), Gauss points on
+        # each geometric edge once (shared by two cells)
+        off = np.flatnonzero(~on)
+        if off.size:
+            key = np.sort(cx.edges[off], axis=1)
+            uniq, inv = np.unique(key, axis=0, return_inverse=True)
+            inv = inv.ravel()
+            gx, gw = np.polynomial.legendre.leggauss(GAUSS_EDGE)
+            s, w = 0.5 * (gx + 1), 0.5 * gw
+            a, b = cx.nodes[uniq[:, 0]], cx.nodes[uniq[:, 1]]
+            Y = (a[:, None] + s[None, :, None] * (b - a)[:, None]).reshape(-1, 2)
+            SL = self._single_layer(Y)                                   # (2Y, nW)
+            DL = self._columns(lambda p, e: bem.representation(p, e, zW), nV, Y, 2)
+            R = DL + SL @ self._P(bem.B)                 # Phi~[u] = V~ Psi(u) - K~ u
+            Nw, _ = newton_operators(cx, Y, self.E, self.nu, gradient=False)
+            Ut = (Nw - SL @ self._P(self._boundary_w())).reshape(len(uniq), len(s), 2, nc3)
+            Uu = R.reshape(len(uniq), len(s), 2, nV)
+            cells_off = cx.edge_cell[off]
+            np.add.at(A_u, cells_off, np.einsum("eqiv,q,em->eimv", Uu[inv], w, fac[off]))
+            np.add.at(A_tau, cells_off, np.einsum("eqit,q,em->eimt", Ut[inv], w, fac[off]))
+        self.A_u = A_u.reshape(4 * nc, nV)
+        self.A_tau = A_tau.reshape(4 * nc, nc3)
+        # G_v = sum_c |c| tau_c : g_c(phi_v)   (tau : g = t11 g11 + t22 g22 + t12 (g12 + g21))
+        T = np.zeros((nc, 2, 2, nc, 3))
+        c = np.arange(nc)
+        T[c, 0, 0, c, 0] = T[c, 1, 1, c, 1] = T[c, 0, 1, c, 2] = T[c, 1, 0, c, 2] = 1.0
+        T *= cx.areas[:, None, None, None, None]
+        self.G = self.A_u.T @ T.reshape(4 * nc, nc3)
+
+    def _single_layer(self, Y: np.ndarray) -> np.ndarray:
+        """(2 len(Y), nW): the single-layer potential V~ psi at points Y of every P0
+        basis function, by the closed-form segment integrals (with the log R term of
+        :mod:`hpfebe.bem.lame`)."""
+        bem, mesh = self.bem, self.bem.mesh
+        c1, c2 = kelvin_constants(self.E, self.nu)
+        IG = edge_integrals(Y, mesh.a, mesh.b, c1, c2, gradient=False)      # (P, S, 2, 2)
+        IG = IG + c1 * np.log(bem.scale) * mesh.lengths[None, :, None, None] * np.eye(2)
+        out = np.zeros((len(Y), 2, 2 * bem.W_space.ndof))
+        d = bem.W_space.elem_dofs[:, 0]
+        for k in range(2):
+            out[:, :, 2 * d + k] = IG[:, :, :, k].transpose(0, 2, 1)
+        return out.reshape(2 * len(Y), -1)
+
+    def _boundary_w(self) -> np.ndarray:
+        """<w, psi_j> on the boundary elements (P0 traction space), graded Gauss (w is
+        like r log r where interior cell edges meet Gamma)."""
+        bem, cx, mesh = self.bem, self.cells, self.bem.mesh
+        nW, nc3 = 2 * bem.W_space.ndof, 3 * cx.ncells
+        s, w = _graded_rule()
+        Yb = (mesh.a[:, None] + s[None, :, None] * (mesh.b - mesh.a)[:, None]).reshape(-1, 2)
+        Nw, _ = newton_operators(cx, Yb, self.E, self.nu, gradient=False)
+        Nw = Nw.reshape(mesh.n_elements, len(s), 2, nc3)
+        Gw = np.zeros((nW, nc3))
+        wdof = bem.W_space.elem_dofs[:, 0]
+        for c in range(2):
+            Gw[2 * wdof + c] = np.einsum("eqt,q,e->et", Nw[:, :, c], w, mesh.lengths)
+        return Gw
+
+    # ------------------------------------------------------------------ fields
+    def tau(self, eps_p: np.ndarray) -> np.ndarray:
+        """(3 ncell,) initial stress of the cell plastic strains (ncell, 3, 3)."""
+        return initial_stress(eps_p, self.E, self.nu).ravel()
+
+    def strain(self, u: np.ndarray, eps_p: np.ndarray | None = None) -> np.ndarray:
+        """(ncell, 3, 3) total strain (plane strain embedding) at the cell points for the
+        boundary displacement u and the cell plastic strain (default: committed)."""
+        u = np.asarray(u, dtype=float)
+        if u.shape != (self.ndofs,):
+            raise ValueError(f"u must have shape ({self.ndofs},), got {u.shape}")
+        ep = self.committed.eps_p if eps_p is None else eps_p
+        g = (self.A_u @ u + self.A_tau @ self.tau(ep)).reshape(-1, 2, 2)
+        return embed_plane(0.5 * (g + np.swapaxes(g, 1, 2)))
+
+    def plastic_force(self, eps_p: np.ndarray | None = None) -> np.ndarray:
+        """G(eps_p, Phi_i) of (4.29) for every boundary basis function."""
+        ep = self.committed.eps_p if eps_p is None else eps_p
+        return self.G @ self.tau(ep)
+
+    # ------------------------------------------------------------------ protocol
+    def internal_force(self, u: np.ndarray):
+        """``scheme="explicit"`` (Algorithm 4.2): (S_hat u - G(eps_p committed), S_hat),
+        the plastic strain only on the right-hand side.  ``scheme="implicit"`` (beyond
+        the thesis): (S_hat u - G(tau*(u)), K_T) with tau*(u) the backward Euler plastic
+        state at the boundary displacement u (:meth:`implicit_response`) and its exact
+        derivative K_T = S_hat - G (I - D Sym A_tau)^-1 D Sym A_u (D = (C - C_alg) per
+        cell, in-plane)."""
+        u = np.asarray(u, dtype=float)
+        if self.scheme == "explicit":
+            return self.S @ u - self.plastic_force(), self.K
+        tau, _, KT = self.implicit_response(u)
+        return self.S @ u - self.G @ tau, sp.csr_matrix(KT)
+
+    def _sym(self) -> np.ndarray:
+        """(3 ncell, 4 ncell): displacement gradient rows -> (eps11, eps22, 2 eps12)."""
+        nc = self.cells.ncells
+        Sm = np.zeros((nc, 3, nc, 4))
+        c = np.arange(nc)
+        Sm[c, 0, c, 0] = Sm[c, 1, c, 3] = 1.0
+        Sm[c, 2, c, 1] = Sm[c, 2, c, 2] = 1.0
+        return Sm.reshape(3 * nc, 4 * nc)
+
+    def implicit_response(self, u: np.ndarray, tol: float = 1e-10, max_iter: int = 30):
+        """Backward Euler plastic state at u: tau = tau(RM(eps(u, tau))) from the
+        committed history, solved by Newton in tau (Jacobian I - D Sym A_tau, D the
+        derivative of tau(eps_p(eps)) = (C - C_alg) in-plane).  Returns (tau, ReturnMap,
+        tangent matrix); a non-converged inner solve returns NaN tau (the outer Newton
+        then reports divergence and the load step is cut)."""
+        u = np.asarray(u, dtype=float)
+        key = u.tobytes()
+        if getattr(self, "_icache", None) is not None and self._icache[0] == key:
+            return self._icache[1]
+        nc = self.cells.ncells
+        Sym = self._get_sym()
+        Cel = self.material.elastic_tangent()
+        tau = self.tau(self.committed.eps_p)
+        base = Sym @ (self.A_u @ u)
+        scale = self.material.sigma_Y * nc
+        for _ in range(max_iter):
+            e = (base + Sym @ (self.A_tau @ tau)).reshape(nc, 3)
+            eps = np.zeros((nc, 3, 3))
+            eps[:, 0, 0], eps[:, 1, 1] = e[:, 0], e[:, 1]
+            eps[:, 0, 1] = eps[:, 1, 0] = 0.5 * e[:, 2]
+            rm = return_map(self.material, eps, self.committed, "algorithmic")
+            r = tau - self.tau(rm.state.eps_p)
+            dC = Cel[None] - rm.tangent                                  # (nc,3,3,3,3)
+            # D[c, a, b] = d tau_a / d e_b, e = (eps11, eps22, 2 eps12)
+            D = np.einsum("aij,cijkl,bkl->cab", _TAU_SEL, dC, _EPS_SEL)
+            Dm = _block_diag(D)
+            J = np.eye(3 * nc) - Dm @ (Sym @ self.A_tau)
+            if np.abs(r).sum() <= tol * (scale + np.abs(tau).sum()):
+                break
+            tau = tau - np.linalg.solve(J, r)
+        else:
+            tau = np.full_like(tau, np.nan)
+        KT = self.S - self.G @ np.linalg.solve(J, Dm @ (Sym @ self.A_u))
+        out = (tau, rm, KT)
+        self._icache = (key, out)
+        return out
+
+    def _get_sym(self):
+        if getattr(self, "_Sym", None) is None:
+            self._Sym = self._sym()
+        return self._Sym
+
+    def update(self, u: np.ndarray, eps_p: np.ndarray | None = None):
+        """Return map at the cell points from the committed state with the strain of
+        (u, eps_p): the :class:`ReturnMap` (a pure function)."""
+        return return_map(self.material, self.strain(u, eps_p), self.committed, None)
+
+    def commit(self, u: np.ndarray) -> None:
+        """explicit: forward Euler update of the plastic strain from the committed
+        state; implicit: the backward Euler state of :meth:`implicit_response`."""
+        if self.scheme == "implicit":
+            _, rm, _ = self.implicit_response(u)
+        else:
+            rm = self.update(u)
+        self.committed, self.sigma, self.plastic = rm.state.copy(), rm.sigma, rm.plastic
+        self._icache = None
+
+    def staggered_step(self, solve, tol: float = 1e-8, max_iter: int = 200):
+        """Algorithm 4.2 within one load step: u^(k+1) = solve(G(eps_p^(k))) (the
+        elastic solve with the plastic force on the right-hand side, a callable
+        returning u), eps_p^(k+1) from the return map at u^(k+1); fixed point of
+        :func:`hpfebe.nonlinear.fixed_point` on eps_p.  Commits the converged state and
+        returns (u, SolverInfo)."""
+        state = {}
+
+        def upd(x):
+            ep = x.reshape(-1, 3, 3)
+            u = solve(self.G @ self.tau(ep))
+            rm = return_map(self.material, self.strain(u, ep), self.committed, None)
+            state.update(u=u, rm=rm)
+            return rm.state.eps_p.ravel()
+
+        x0 = self.committed.eps_p.ravel()
+        x, info = fixed_point(upd, x0, tol=tol, max_iter=max_iter, min_iter=1)
+        rm = state["rm"]
+        if info.converged:
+            self.committed, self.sigma, self.plastic = rm.state.copy(), rm.sigma, rm.plastic
+        return state["u"], info
+
+    def fields(self) -> dict:
+        """Cell fields of the committed state: ||eps_p||, ||dev sigma||, plastic flag."""
+        return {"eps_p_norm": tensor_norm(self.committed.eps_p),
+                "dev_sigma_norm": tensor_norm(dev(self.sigma)),
+                "plastic": self.plastic.astype(float)}
+
+
+class DirichletSolver:
+    """The elastic solve of Algorithm 4.2 for a body without contact: boundary dofs
+    ``fixed`` prescribed to lam * ``values``, the free dofs loaded by lam * ``f_ext`` and
+    the plastic force g:  S_hat_ff u_f = g_f + lam f_ext_f - S_hat_fc u_c  (S_hat_ff
+    factorised once; the prescribed dofs must remove the rigid motions)."""
+
+    def __init__(self, body: ElastoPlasticBE, fixed, values, f_ext=None):
+        n = body.ndofs
+        self.fixed = np.asarray(fixed, dtype=np.int64)
+        if self.fixed.size == 0 or self.fixed.min() < 0 or self.fixed.max() >= n:
+            raise ValueError(f"fixed must be a non-empty list of dofs in [0, {n})")
+        self.values = np.broadcast_to(np.asarray(values, dtype=float), self.fixed.shape).copy()
+        self.f_ext = np.zeros(n) if f_ext is None else np.asarray(f_ext, dtype=float)
+        if self.f_ext.shape != (n,):
+            raise ValueError(f"f_ext must have shape ({n},), got {self.f_ext.shape}")
+        self.free = np.setdiff1d(np.arange(n), self.fixed)
+        S = body.S
+        self.S_fc = S[np.ix_(self.free, self.fixed)]
+        self.cho = sla.cho_factor(S[np.ix_(self.free, self.free)])
+        self.n, self.lam = n, 0.0
+
+    def __call__(self, g: np.ndarray) -> np.ndarray:
+        u = np.zeros(self.n)
+        u[self.fixed] = self.lam * self.values
+        rhs = g[self.free] + self.lam * self.f_ext[self.free] - self.S_fc @ u[self.fixed]
+        u[self.free] = sla.cho_solve(self.cho, rhs)
+        return u
+
+
+def staggered_path(body: ElastoPlasticBE, solver: DirichletSolver, factors,
+                   tol: float = 1e-8, max_iter: int = 200):
+    """Algorithm 4.2 for a body without contact: for every load factor (increasing),
+    :meth:`ElastoPlasticBE.staggered_step` (eps_p iterated to the fixed point, then
+    committed).  ``max_iter=1`` is the one-pass forward Euler of the thesis (eps_p
+    updated once per load step; reported as not converged by the fixed point, accepted
+    here).  Returns (u, list of SolverInfo); stops at the first step whose fixed point
+    did not converge (with ``max_iter`` > 1)."""
+    factors = np.asarray(factors, dtype=float)
+    if factors.ndim != 1 or factors.size == 0 or np.any(np.diff(factors) <= 0):
+        raise ValueError("factors must be a non-empty increasing sequence of load factors")
+    infos, u = [], np.zeros(body.ndofs)
+    for lam in factors:
+        solver.lam = float(lam)
+        if max_iter == 1:
+            u = solver(body.plastic_force())
+            body.commit(u)
+            continue
+        u, info = body.staggered_step(solver, tol=tol, max_iter=max_iter)
+        info.load_factor = float(lam)
+        infos.append(info)
+        if not info.converged:
+            break
+    return u, infos
+
+
+class PlasticBEBody(BEBody):
+    """An :class:`ElastoPlasticBE` as a contact body (kind "BE", the BEBody geometry of
+    its boundary mesh): internal_force(u) = (S_hat u - G(eps_p committed), S_hat) and
+    commit(u) the forward Euler update of eps_p - Algorithm 4.2: backward Euler (Newton)
+    for the contact, forward Euler for the plasticity, only the contact blocks of the
+    matrix (4.33) change.  With ``scheme="implicit"`` the body's backward Euler force and
+    consistent tangent instead (beyond the thesis)."""
+
+    linear = False
+
+    def __init__(self, be: ElastoPlasticBE):
+        if not isinstance(be, ElastoPlasticBE):
+            raise ValueError(f"be must be an ElastoPlasticBE, got {type(be).__name__}")
+        super().__init__(be.bem, S=be.S)
+        self.plastic = be
+
+    def internal_force(self, u):
+        f, T = self.plastic.internal_force(u)
+        return f, (self.S if self.plastic.scheme == "explicit" else T.toarray())
+
+    def commit(self, u) -> None:
+        self.plastic.commit(u)
+
+
+SIDES = ("bottom", "right", "top", "left")
+
+
+def rectangle_work_piece(box, nx: int, ny: int, material: J2Material,
+                         scheme: str = "explicit") -> ElastoPlasticBE:
+    """The BE work piece on ``box`` = (x0, x1, y0, y1): a degree-1 LameBEM (plane
+    strain, sides labelled bottom/right/top/left as the FE meshes of
+    :mod:`hpfebe.contact.stamping`) and nx x ny rectangular cells carrying eps_p."""
+    from .fem.elasticity import rectangle_mesh
+    for name, v in (("nx", nx), ("ny", ny)):
+        if isinstance(v, bool) or int(v) != v or v < 1:
+            raise ValueError(f"{name} must be a positive integer, got {v!r}")
+    x0, x1, y0, y1 = (float(v) for v in box)
+    if not (x1 > x0 and y1 > y0):
+        raise ValueError(f"box must be (x0, x1, y0, y1) with x1 > x0, y1 > y0, got {box!r}")
+    mesh = BoundaryMesh.polygon([(x0, y0), (x1, y0), (x1, y1), (x0, y1)],
+                                n=[nx, ny, nx, ny], labels=list(SIDES))
+    bem = LameBEM(mesh, material.E, material.nu, "strain")
+    m = rectangle_mesh(x0, x1, y0, y1, int(nx), int(ny), "quad")
+    return ElastoPlasticBE(bem, CellComplex(m.p.T, m.t.T), material, scheme)
