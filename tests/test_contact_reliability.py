@@ -71,3 +71,13 @@ def test_extreme_eps_is_not_reported_as_converged(body):
     assert ref.converged
     assert not res.converged and "ill-conditioned" in res.reason, res.reason
     assert res.info.backward_error > 1e-6
+
+
+def test_friction_at_extreme_eps_names_ill_conditioning(body):
+    """Coulomb friction with eps = 1e-20 on a fixed body used to end with "singular
+    Newton matrix (body not fixed?)": the body is fixed; the cause is conditioning."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        res = solve_friction(body, 1e-20, 1e-20, -D, friction="coulomb", mu_f=0.3)
+    assert not res.converged
+    assert "ill-conditioned" in res.reason and "not fixed" not in res.reason, res.reason
