@@ -33,9 +33,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..nonlinear import SolverInfo
-from .bodies import BEBody, RigidObstacle, against_obstacle
+from .bodies import RigidObstacle, against_obstacle
 from .laws import positive
-from .positive_part import ExactPositivePart
 from .two_body import TwoBodyContact
 
 
@@ -117,22 +116,14 @@ def solve_penalty(bem, eps: float, gap, load=None, contact_label: str = "C",
 
 def penalty_terms(bem, U, gap, contact_label: str = "C"):
     """(int (U_n - g_h)_+^2 / 2, the vector int (U_n - g_h)_+ v_n over V_hp^2, the number
-    of contact elements in (partial) contact), integrated exactly (module doc)."""
-    elems = np.flatnonzero(bem.mesh.where(contact_label))
-    if elems.size == 0:
-        raise ValueError(f"contact_label {contact_label!r}: no element carries this label")
-    U = np.asarray(U, dtype=float)
-    q = ExactPositivePart(bem.mesh, bem.V_space, elems, gap).points(U)
-    body, ids = BEBody(bem), q["ids"]
-    if ids.size == 0:
-        return 0.0, np.zeros(U.size), 0
-    tc, tv = body.trace(ids, q["s"])
-    n = bem.mesh.normals[ids]
-    pen = np.einsum("nj,ncj,nc->n", tv, U[tc], n) - q["g0"]      # U_n - g_h > 0
-    F = np.zeros(U.size)
-    for c in (0, 1):
-        np.add.at(F, tc[:, c, :], (q["weights"] * pen * n[:, c])[:, None] * tv)
-    return 0.5 * float(q["weights"] @ pen ** 2), F, q["n_active"]
+    of contact elements in (partial) contact), integrated exactly (module doc): the
+    contact terms of :func:`solve_penalty` with eps = 1."""
+    body, _, _ = against_obstacle(bem, None, contact_label, "D", None)
+    pr = TwoBodyContact(body, RigidObstacle(gap), contact_label, eps_n=1.0,
+                        quadrature="exact")
+    cs = pr.contact_state(np.asarray(U, dtype=float), 0.0)
+    return (0.5 * float(cs["weights"] @ cs["p_n"] ** 2), pr.contact_force(cs),
+            cs["n_active"])
 
 
 def penalty_residual(bem, U, eps: float, gap, S=None, contact_label: str = "C") -> np.ndarray:

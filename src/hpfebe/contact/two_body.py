@@ -268,11 +268,6 @@ class TwoBodyContact:
         # (4.27) / (4.33): FE blocks sparse, a BE block (dense S_hat) inside; a system
         # without FE body (BE against rigid or BE) stays dense
         self.dense = "FE" not in (sb.kind, mb.kind)
-        if self.dense:
-            Ks = [b.S for b in (sb, mb) if b.kind == "BE"]
-            self.K = sla.block_diag(*Ks)
-        else:
-            self.K = sp.block_diag([sb.K, mb.K], format="csr")
         if mb.kind == "rigid":
             self._build_rigid(slave_boundary)
         else:
@@ -293,6 +288,14 @@ class TwoBodyContact:
             raise ValueError("quadrature='exact' is for a BE body against a rigid obstacle "
                              "without friction")
         return ExactPositivePart(sb.mesh, sb.space, np.unique(self.point_facets), mb.gap)
+
+    @property
+    def K(self):
+        """The stiffness of the bodies (4.27)/(4.33) at rest: dense without FE body."""
+        sb, mb = self.bodies["slave"], self.bodies["master"]
+        if self.dense:
+            return sla.block_diag(*[b.S for b in (sb, mb) if b.kind == "BE"])
+        return sp.block_diag([sb.K, mb.K], format="csr")
 
     # ------------------------------------------------------------------ geometry
     def _build_rigid(self, slave_boundary) -> None:
