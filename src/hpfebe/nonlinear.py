@@ -13,7 +13,7 @@ A problem tells Newton three things (the :class:`NewtonProblem` protocol):
 
 Stopping test: ||residual|| <= atol + tol * it.scale (norm ``norm``).  The merit is
 whatever the problem's globalisation needs: an energy for a potential problem (penalty,
-Tresca), 1/2 |R|^2 or |R| otherwise (Coulomb).
+Tresca), ||R||_2 otherwise (Coulomb).
 
 A load path (:func:`load_path`) runs Newton for each load factor of an increasing
 sequence; a problem's history (e.g. the slip of a friction law) is updated by
