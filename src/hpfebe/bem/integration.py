@@ -384,34 +384,6 @@ def _add_point(w, phi, psi, mt, mr, d, Kq, out):
                     out[k * d + c1, l * d + c2] += f * Kq[0, c1 * d + c2]
 
 
-@njit(cache=True, inline="always")
-def _split_rule(part, n, i, gx, gw, lx, lw):
-    """Point i of the n-point rule on [0, 1] of ``part`` 0 (Gauss) or 1 (log-weighted,
-    int_0^1 log(t) f(t) dt = -sum lw f): the two parts of a singular integral."""
-    if part == 0:
-        return gx[n, i], gw[n, i]
-    return lx[n, i], -lw[n, i]
-
-
-@njit(cache=True, inline="always")
-def _split_kernel(part, kernel, logc, haslog, kp, dd, rx, ry, lr, nI, nJ, rxs, rys, Kq):
-    """Kernel factor at one point into Kq[0] for the two parts of a singular integral
-    k(r) = logc log|r| + k_reg(r), |r| = u R: part 0 the smooth factor k_reg(r) + logc lr
-    (lr = log R, the regular part of log|r|), part 1 the factor logc of log u."""
-    if part == 0:
-        rxs[0] = rx
-        rys[0] = ry
-        # the literal 1 gives kernel_batch a second specialisation (0.5 s of compile
-        # time) in which LLVM unrolls the one-point batch: 3 us less per adjacent pair
-        kernel_batch(kernel, rxs, rys, 1, nI, nJ, kp, Kq)
-        if haslog:
-            for c in range(dd):
-                Kq[0, c] += logc[c] * lr
-    else:
-        for c in range(dd):
-            Kq[0, c] = logc[c]
-
-
 @njit(cache=True)
 def coincident_block(kernel, logc, haslog, kp, d, aI, bI, nI, kt, pt, kr, pr,
                      gx, gw, lx, lw, gll_x, gll_b, phi, psi, Kq, rxs, rys, out):
@@ -429,11 +401,19 @@ def coincident_block(kernel, logc, haslog, kp, d, aI, bI, nI, kt, pt, kr, pr,
     nl = (deg + 3) // 2 + 1
     dd = d * d
     logL = math.log(L)
-    # regular part: Gauss in z and tau; log z part: log rule in z
+    # regular part: Gauss in z and tau; log z part: log rule in z.  The two parts are
+    # written out here and in adjacent_block, with the literal one-point kernel_batch
+    # call (LLVM unrolls it): the same code in inline="always" helpers made V + K + W
+    # 1.2x slower at N = 64, p = 1 (issue 14; these pairs dominate small N)
     for part in range(2):
         nzz = nz if part == 0 else nl
         for iz in range(nzz):
-            z, wz = _split_rule(part, nzz, iz, gx, gw, lx, lw)
+            if part == 0:
+                z = gx[nz, iz]
+                wz = gw[nz, iz]
+            else:
+                z = lx[nl, iz]
+                wz = -lw[nl, iz]     # int log z f = - sum lw f
             for it in range(ntau):
                 t = (1.0 - z) * gx[ntau, it]
                 w = wz * gw[ntau, it] * (1.0 - z) * L * L
@@ -444,8 +424,16 @@ def coincident_block(kernel, logc, haslog, kp, d, aI, bI, nI, kt, pt, kr, pr,
                         s, g, sgn = t, t + z, -1.0
                     eval_basis(kt, pt, 2.0 * s - 1.0, gll_x, gll_b, phi)
                     eval_basis(kr, pr, 2.0 * g - 1.0, gll_x, gll_b, psi)
-                    _split_kernel(part, kernel, logc, haslog, kp, dd, sgn * z * L * ex,
-                                  sgn * z * L * ey, logL, nI, nI, rxs, rys, Kq)
+                    if part == 0:
+                        rxs[0] = sgn * z * L * ex
+                        rys[0] = sgn * z * L * ey
+                        kernel_batch(kernel, rxs, rys, 1, nI, nI, kp, Kq)
+                        if haslog:
+                            for c in range(dd):
+                                Kq[0, c] += logc[c] * logL
+                    else:
+                        for c in range(dd):
+                            Kq[0, c] = logc[c]
                     _add_point(w, phi, psi, mt, mr, d, Kq, out)
             if part == 1 and not haslog:
                 break
@@ -522,7 +510,12 @@ def adjacent_block(kernel, logc, haslog, kp, d, aI, bI, nI, aJ, bJ, nJ, vI, vJ,
                 break
             nuu = nu if part == 0 else nl
             for iu in range(nuu):
-                u, wu = _split_rule(part, nuu, iu, gx, gw, lx, lw)
+                if part == 0:
+                    u = gx[nu, iu]
+                    wu = gw[nu, iu]
+                else:
+                    u = lx[nl, iu]
+                    wu = -lw[nl, iu]
                 for iw in range(nw):
                     w = wx[iw]
                     # local distances from v (fractions of ell) on I and J
@@ -535,16 +528,21 @@ def adjacent_block(kernel, logc, haslog, kp, d, aI, bI, nI, aJ, bJ, nJ, vI, vJ,
                     g = b_loc * fJ if vJ == 0 else 1.0 - b_loc * fJ
                     eval_basis(kt, pt, 2.0 * s - 1.0, gll_x, gll_b, phi)
                     eval_basis(kr, pr, 2.0 * g - 1.0, gll_x, gll_b, psi)
-                    lr = 0.0
-                    if haslog and part == 0:
-                        if tri == 0:
-                            R = math.hypot(dIx - w * dJx, dIy - w * dJy)
-                        else:
-                            R = math.hypot(w * dIx - dJx, w * dIy - dJy)
-                        lr = math.log(ell * R)
-                    _split_kernel(part, kernel, logc, haslog, kp, dd,
-                                  ell * (a_loc * dIx - b_loc * dJx),
-                                  ell * (a_loc * dIy - b_loc * dJy), lr, nI, nJ, rxs, rys, Kq)
+                    if part == 0:
+                        rxs[0] = ell * (a_loc * dIx - b_loc * dJx)
+                        rys[0] = ell * (a_loc * dIy - b_loc * dJy)
+                        kernel_batch(kernel, rxs, rys, 1, nI, nJ, kp, Kq)
+                        if haslog:
+                            if tri == 0:
+                                R = math.hypot(dIx - w * dJx, dIy - w * dJy)
+                            else:
+                                R = math.hypot(w * dIx - dJx, w * dIy - dJy)
+                            lr = math.log(ell * R)
+                            for c in range(dd):
+                                Kq[0, c] += logc[c] * lr
+                    else:
+                        for c in range(dd):
+                            Kq[0, c] = logc[c]
                     _add_point(wt, phi, psi, mt, mr, d, Kq, out)
     # the part of the longer element outside the Duffy square is a far pair
     # parametrised from the shared vertex (rI, rJ of far_block): exact near it
