@@ -33,6 +33,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 import scipy.linalg as sla
+from numba import njit
 
 from ..bem.lame import LameBEM
 from ..coupling.mortar import MortarProjection
@@ -42,6 +43,107 @@ from ..quadrature import gauss_legendre, gauss_lobatto
 
 
 # --------------------------------------------------------------------------- Polyak
+#: status codes of :func:`_polyak_kernel`
+_PCG_REASONS = ("max_iter", "converged", "diverged: non-finite gradient",
+                "matrix not positive definite on the free set")
+
+
+@njit(cache=True)
+def _norm2(v):
+    """||v||_2 exactly as numpy's ``np.linalg.norm`` (sqrt of the BLAS dot)."""
+    return np.sqrt(np.dot(v, v))
+
+
+@njit(cache=True)
+def _kkt_met(r, A, x, tol, nb, bound_Ax):
+    """r <= tol * max(||b||, ||A x||, 1e-300) (the KKT threshold of projected_cg),
+    deciding without the product A x where the bounds ||b|| <= ... and ||A x|| <=
+    ``bound_Ax`` (= ||A||_F ||x|| (1 + 1e-8), a rigorous bound of the computed norm)
+    already decide it; otherwise with A x as in the numpy formulation."""
+    lo = tol * max(nb, 1e-300)
+    if r <= lo:
+        return True
+    if r > tol * max(nb, bound_Ax, 1e-300):
+        return False
+    return r <= tol * max(nb, _norm2(np.dot(A, x)), 1e-300)
+
+
+@njit(cache=True)
+def _polyak_kernel(A, b, u, x, tol, max_iter, res):
+    """The iteration of :func:`projected_cg` (compiled; the same floating-point
+    operations in the same order as the numpy formulation it replaces: BLAS gemv / dot,
+    norms as sqrt(dot); the product A x of the stopping threshold only where the bound
+    ||A x|| <= ||A||_F ||x|| leaves the decision open, :func:`_kkt_met`).  ``x`` (start,
+    already <= u) is overwritten; the KKT residuals go into ``res``.  Returns
+    (status, steps, n_residuals): status 0 max_iter, 1 converged, 2 non-finite gradient,
+    3 not positive definite on the free set."""
+    n = b.size
+    g = np.dot(A, x) - b
+    nb = _norm2(b)
+    nA = np.sqrt(np.sum(A * A)) * (1.0 + 1e-8)
+    steps = 0
+    nres = 0
+    free = np.empty(n, dtype=np.bool_)
+    pg = np.empty(n)
+    gf = np.empty(n)
+    p = np.empty(n)
+    while steps < max_iter:
+        # KKT: projected gradient (max(g, 0) on the active set, g elsewhere)
+        for i in range(n):
+            gi = g[i]
+            if x[i] >= u[i]:
+                pg[i] = gi if (gi > 0.0 or gi != gi) else 0.0
+            else:
+                pg[i] = gi
+        r = _norm2(pg)
+        if nres < res.size:
+            res[nres] = r
+        nres += 1
+        if not np.isfinite(r):
+            return 2, steps, nres
+        if _kkt_met(r, A, x, tol, nb, nA * _norm2(x)):
+            return 1, steps, nres
+        for i in range(n):
+            free[i] = not (x[i] >= u[i] and g[i] <= 0.0)   # held: multiplier -g_i >= 0
+            p[i] = -g[i] if free[i] else 0.0
+        rr = np.dot(p, p)
+        while steps < max_iter:
+            steps += 1
+            Ap = np.dot(A, p)
+            pAp = np.dot(p, Ap)
+            if pAp <= 0:
+                return 3, steps, nres
+            alpha = rr / pAp
+            afeas = np.inf
+            for i in range(n):
+                if free[i] and p[i] > 0:
+                    a = (u[i] - x[i]) / p[i]
+                    if a < afeas:
+                        afeas = a
+            if afeas < alpha:                    # hit a bound: cut, restart CG
+                for i in range(n):
+                    x[i] = x[i] + afeas * p[i]
+                for i in range(n):
+                    if free[i] and p[i] > 0:
+                        if x[i] >= u[i] - 1e-14 * max(abs(u[i]), 1.0):
+                            x[i] = u[i]
+                g = np.dot(A, x) - b
+                break
+            for i in range(n):
+                x[i] = x[i] + alpha * p[i]
+                g[i] = g[i] + alpha * Ap[i]
+                gf[i] = g[i] if free[i] else 0.0
+            if _kkt_met(_norm2(gf), A, x, tol, nb, nA * _norm2(x)):
+                g = np.dot(A, x) - b
+                break
+            rr_new = np.dot(gf, gf)
+            beta = rr_new / rr
+            for i in range(n):
+                p[i] = -gf[i] + beta * p[i]
+            rr = rr_new
+    return 0, steps, nres
+
+
 def projected_cg(A, b, upper, x0=None, tol: float = 1e-10, max_iter: int | None = None):
     """Polyak's projected conjugate gradients [53] for the bound-constrained QP
 
@@ -53,72 +155,34 @@ def projected_cg(A, b, upper, x0=None, tol: float = 1e-10, max_iter: int | None 
     (gradient g_i = (A x - b)_i > 0, pulling into the interior) are all released.
     Converged when the projected gradient (g on the free set, max(g, 0) on the active
     set) is <= tol * max(||b||, ||A x||) (the KKT conditions).  Returns (x, SolverInfo);
-    ``info.counts`` has the CG steps and the final active set size."""
-    A = np.asarray(A, dtype=float)
-    b = np.asarray(b, dtype=float)
-    u = np.asarray(upper, dtype=float)
+    ``info.counts`` has the CG steps and the final active set size.  The iteration is
+    compiled (:func:`_polyak_kernel`)."""
+    A = np.ascontiguousarray(A, dtype=float)
+    b = np.ascontiguousarray(b, dtype=float)
+    u = np.ascontiguousarray(upper, dtype=float)
     n = b.size
-    if A.shape != (n, n) or u.shape != (n,):
-        raise ValueError(f"A must be ({n}, {n}) and upper ({n},), got {A.shape}, {u.shape}")
+    if b.ndim != 1 or A.shape != (n, n) or u.shape != (n,):
+        raise ValueError(f"b must be a vector ({n},), A ({n}, {n}) and upper ({n},), got "
+                         f"{b.shape}, {A.shape}, {u.shape}")
+    if x0 is not None and np.shape(x0) != (n,):
+        raise ValueError(f"x0 must have shape ({n},), got {np.shape(x0)}")
     if not (np.isfinite(tol) and tol > 0):
         raise ValueError(f"tol must be positive, got {tol!r}")
     if np.any(np.isnan(u)):
         raise ValueError("upper contains NaN")
     max_iter = 20 * n + 100 if max_iter is None else int(max_iter)
-    x = np.minimum(np.zeros(n) if x0 is None else np.asarray(x0, dtype=float), u)
-    g = A @ x - b
-    info = SolverInfo(False, "max_iter")
-    steps = 0
+    return _projected_cg_checked(A, b, u, x0, float(tol), max_iter)
 
-    def kkt(x, g):
-        at = x >= u
-        pg = np.where(at, np.maximum(g, 0.0), g)
-        return float(np.linalg.norm(pg)), float(tol * max(np.linalg.norm(b),
-                                                           np.linalg.norm(A @ x), 1e-300))
 
-    while steps < max_iter:
-        r, thr = kkt(x, g)
-        info.residuals.append(r)
-        if not np.isfinite(r):
-            info.reason = "diverged: non-finite gradient"
-            break
-        if r <= thr:
-            info.converged, info.reason = True, "converged"
-            break
-        active = (x >= u) & (g <= 0.0)           # held: multiplier -g_i >= 0
-        free = ~active
-        p = np.where(free, -g, 0.0)
-        rr = p @ p
-        while steps < max_iter:
-            steps += 1
-            Ap = A @ p
-            pAp = p @ Ap
-            if pAp <= 0:
-                info.reason = "matrix not positive definite on the free set"
-                info.counts = dict(cg_steps=steps, active=int(np.sum(x >= u)))
-                info.iterations = steps
-                return x, info
-            alpha = rr / pAp
-            up = free & (p > 0)
-            afeas = np.min((u[up] - x[up]) / p[up]) if np.any(up) else np.inf
-            if afeas < alpha:                    # hit a bound: cut, restart CG
-                x = x + afeas * p
-                with np.errstate(invalid="ignore"):
-                    hit = up & (x >= u - 1e-14 * np.maximum(np.abs(u), 1.0))
-                x[hit] = u[hit]
-                g = A @ x - b
-                break
-            x = x + alpha * p
-            g = g + alpha * Ap
-            gf = np.where(free, g, 0.0)
-            if np.linalg.norm(gf) <= kkt(x, g)[1]:
-                g = A @ x - b
-                break
-            rr_new = gf @ gf
-            p = -gf + (rr_new / rr) * p
-            rr = rr_new
-    info.iterations = steps
-    info.counts = dict(cg_steps=steps, active=int(np.sum(x >= u)))
+def _projected_cg_checked(A, b, u, x0, tol: float, max_iter: int):
+    """:func:`projected_cg` on validated input (A, b, u contiguous float arrays)."""
+    x = np.minimum(np.zeros(b.size) if x0 is None else np.asarray(x0, dtype=float), u)
+    res = np.empty(max_iter + 1)
+    status, steps, nres = _polyak_kernel(A, b, u, x, tol, max_iter, res)
+    info = SolverInfo(status == 1, _PCG_REASONS[status])
+    info.residuals = res[:min(nres, res.size)].tolist()
+    info.iterations = int(steps)
+    info.counts = dict(cg_steps=int(steps), active=int(np.count_nonzero(x >= u)))
     return x, info
 
 
@@ -394,12 +458,29 @@ class MortarContact:
         """Algorithm 4.4 step 2: frictionless contact of body 1 against the obstacle Q
         with the friction load F w lambda (``bound``: a nodal friction bound replacing F,
         e.g. mu_f p_n), by projected CG.  Returns (x, info)."""
+        Fw, upper = self._qp_data(Q, bound)
+        return self._qp(Fw, upper, np.asarray(lam, dtype=float), x0, tol)
+
+    def _qp_data(self, Q, bound):
+        """The pieces of the contact QP fixed for one obstacle Q and one friction bound:
+        the friction weights F w (or s w) and the upper bounds (g + Q_n on U_n, none on
+        U_t)."""
         Qn, _ = self.frame(Q)
-        rhs = self.b.copy()
         F = self.F if bound is None else np.asarray(bound, dtype=float)
-        rhs[self.nc:] -= F * self.w * lam
         upper = np.concatenate([self.gap + Qn, np.full(self.nc, np.inf)])
-        return projected_cg(self.A, rhs, upper, x0=x0, tol=tol)
+        return F * self.w, upper
+
+    def _qp(self, Fw, upper, lam, x0, tol):
+        """The contact QP with the friction load (F w) lambda (A, b of body 1 in the
+        node frames, read at every call: subclasses may replace them; compiled
+        projected CG without re-validating the shapes)."""
+        rhs = np.array(self.b, dtype=float)
+        rhs[self.nc:] -= Fw * lam
+        n = rhs.size
+        A = np.ascontiguousarray(self.A, dtype=float)
+        if A.shape != (n, n):
+            raise ValueError(f"A must be ({n}, {n}), got {A.shape}")
+        return _projected_cg_checked(A, rhs, upper, x0, float(tol), 20 * n + 100)
 
     def uzawa(self, Q, rho: float = 1.0, tol: float = 1e-6, max_iter: int = 2000,
               lam0=None, x0=None, cg_tol: float = 1e-11, bound=None):
@@ -407,20 +488,25 @@ class MortarContact:
         lambda_{m+1} = P_Lambda(lambda_m + rho F (U_t - Q_t)), stop when
         ||lambda_m - lambda_{m-1}|| <= TOL_U ||lambda_m||.  Returns (x, lambda, info);
         x = (U_n, U_t) at the contact nodes for the returned lambda.  ``bound``: nodal
-        friction bound s_j replacing F (lambda_j += rho s_j (U_t - Q_t)_j)."""
+        friction bound s_j replacing F (lambda_j += rho s_j (U_t - Q_t)_j).  The QP
+        data fixed by Q and the bound are built once per call."""
         _check_pos("rho", rho)
         F = self.F if bound is None else np.asarray(bound, dtype=float)
         _, Qt = self.frame(Q)
         lam0 = np.zeros(self.nc) if lam0 is None else np.asarray(lam0, dtype=float)
+        Fw, upper = self._qp_data(Q, bound)
+        rhoF = rho * F
+        nc = self.nc
         state = {"x": x0}
 
         def update(lam):
-            x, info = self.contact_qp(Q, lam, state["x"], cg_tol, bound)
+            x, info = self._qp(Fw, upper, lam, state["x"], cg_tol)
             state["x"] = x
-            return np.clip(lam + rho * F * (x[self.nc:] - Qt), -1.0, 1.0), info
+            # P_Lambda: the pointwise clip to [-1, 1] (np.minimum(np.maximum(.)) = np.clip)
+            return np.minimum(np.maximum(lam + rhoF * (x[nc:] - Qt), -1.0), 1.0), info
 
         lam, info = fixed_point(update, lam0, tol, max_iter, norm=2)
-        x, qinfo = self.contact_qp(Q, lam, state["x"], cg_tol, bound)
+        x, qinfo = self._qp(Fw, upper, lam, state["x"], cg_tol)
         if not qinfo.converged and info.converged:
             info.converged, info.reason = False, f"final QP: {qinfo.reason}"
         return x, lam, info
