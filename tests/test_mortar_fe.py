@@ -1,0 +1,102 @@
+"""The mortar FE/FE contact with an elastoplastic work piece (hpfebe.contact.mortar_fe,
+Section 4.4): the DtN algorithm (Algorithm 4.3 with the elastoplastic Neumann problem)
+converges to the solution of the monolithic semismooth Newton method on a small version
+of the scene; non-convergence of DtN is detected for a diverging damping pair."""
+
+import numpy as np
+import pytest
+
+from hpfebe.contact.mortar_fe import FEMortarContact, fe_trace_mesh, section44_scene
+from hpfebe.fem.elasticity import rectangle_mesh
+
+
+@pytest.fixture(scope="module")
+def scene():
+    # stamp 4 x 8 Q1 cells (5 contact nodes), work piece 16 x 8; the rest as Section 4.4
+    return section44_scene((4, 8), (16, 8), formulation="full")
+
+
+@pytest.fixture(scope="module")
+def mono(scene):
+    sol = scene.monolithic(tol=1e-10)
+    assert sol.info.converged, sol.info.reason
+    return sol
+
+
+def test_dtn_matches_monolithic(scene, mono):
+    sol = scene.dtn(0.5, 0.5, tol=1e-10, newton_tol=1e-10)
+    assert sol.info.converged, sol.info.reason
+    # the work piece yields: the problem is elastoplastic
+    assert sol.extra["fields"]["eps_p_norm_mean"].max() > 0
+    assert mono.extra["fields"]["eps_p_norm_mean"].max() > 0
+    for key in ("u1", "u2"):
+        a, b = sol.extra[key], mono.extra[key]
+        assert np.abs(a - b).max() <= 1e-7 * np.abs(b).max(), key
+    assert np.abs(sol.P - mono.P).max() <= 1e-7 * np.abs(mono.P).max()
+    # the Tresca conditions at the contact nodes and the work piece's equilibrium
+    r = scene.kkt_residual(sol)
+    assert r["lam_excess"] <= 1e-12 and r["complementarity"] <= 1e-8
+    assert r["equilibrium2"] <= 1e-8
+    # nothing committed: the work piece keeps its virgin history for the next run
+    assert np.all(scene.work.committed.alpha == 0)
+
+
+def test_dtn_default_tolerances_close_to_monolithic(scene, mono):
+    """TOL_DtN = 1e-6 (the thesis's): U2 within 1e-5 of the monolithic solution."""
+    sol = scene.dtn(0.5, 0.7)
+    assert sol.info.converged, sol.info.reason
+    assert np.abs(sol.extra["u2"] - mono.extra["u2"]).max() <= \
+        1e-5 * np.abs(mono.extra["u2"]).max()
+    # Uzawa: several iterations in the first DtN iteration, then at most 2
+    uz = [s.counts["uzawa"] for s in sol.info.steps]
+    assert uz[0] >= 2 and max(uz[1:]) <= 2
+
+
+def test_divergence_detected(scene):
+    sol = scene.dtn(0.9, 1.0, max_iter=30)
+    assert not sol.info.converged
+    assert sol.info.reason.startswith(("max_iter", "diverged", "inner solve",
+                                       "no solution"))
+    assert sol.info.iterations <= 30
+
+
+def test_bad_input(scene):
+    with pytest.raises(ValueError, match="omega_D"):
+        scene.dtn(0.0, 0.5)
+    with pytest.raises(ValueError, match="omega_N"):
+        scene.dtn(0.5, 1.5)
+    with pytest.raises(ValueError, match="rho"):
+        scene.dtn(0.5, 0.5, rho=-1.0)
+    with pytest.raises(ValueError, match="F"):
+        FEMortarContact(scene.stamp, scene.work, ("top", (0, 0)), ("bottom", (0, 1e-4)),
+                        -1.0)
+    with pytest.raises(ValueError, match="dirichlet1"):
+        FEMortarContact(scene.stamp, scene.work, ("bottom", (0, 0)), ("bottom", (0, 1e-4)),
+                        0.2)
+    with pytest.raises(ValueError, match="contact"):
+        fe_trace_mesh(rectangle_mesh(0, 1, 0, 1, 2, 2), "middle")
+
+
+def test_trace_mesh_vertices():
+    m = rectangle_mesh(-2, 2, -2, 0, 8, 4)
+    bm, space, vertex = fe_trace_mesh(m, "top")
+    top = space.dofs_on("C")
+    assert top.size == 9
+    assert np.allclose(m.p[1, vertex[top]], 0.0)
+    assert np.allclose(np.sort(m.p[0, vertex[top]]), np.linspace(-2, 2, 9))
+
+
+def test_stamp_condensed_once(scene, monkeypatch):
+    """The stamp's Schur complement is built with the scene and reused by every DtN run
+    (no CondensedBody, no new Cholesky factorisation of the stamp, per damping pair)."""
+    import hpfebe.contact.mortar as mortar
+
+    def refactorised(*args, **kwargs):
+        raise AssertionError("the stamp was factorised again")
+
+    monkeypatch.setattr(mortar.sla, "cho_factor", refactorised)
+    monkeypatch.setattr(mortar, "CondensedBody", refactorised)
+    body1 = scene.body1
+    for pair in ((0.5, 0.7), (0.7, 0.5)):
+        assert scene.dtn(*pair).info.converged
+    assert scene.body1 is body1
