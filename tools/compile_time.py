@@ -9,6 +9,7 @@ warm-start times.
     python tools/compile_time.py            # first LaplaceBEM(mesh).V, LameBEM(...).S_hat
     python tools/compile_time.py --top 40   # more lines
     python tools/compile_time.py --threads 2
+    python tools/compile_time.py --sigs     # signatures of functions compiled twice or more
 
 Issue 14 targets: cold (empty cache) under 10 s, warm first call under 0.5 s.
 """
@@ -69,6 +70,9 @@ def main(argv=None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--top", type=int, default=25, help="lines of the per-function table")
     ap.add_argument("--threads", type=int, default=1, help="NUMBA_NUM_THREADS")
+    ap.add_argument("--sigs", action="store_true",
+                    help="list the signatures of the functions compiled more than once "
+                         "(a Literal[int] argument, a non-contiguous array ...)")
     args = ap.parse_args(argv)
     with tempfile.TemporaryDirectory(prefix="numba_cache_") as cache:
         cold = run(cache, args.threads)
@@ -87,6 +91,12 @@ def main(argv=None) -> None:
     rows = sorted(per_fn.items(), key=lambda kv: -sum(r["self_s"] for r in kv[1]))
     for name, rs in rows[:args.top]:
         print(f"{sum(r['self_s'] for r in rs):7.2f} {len(rs):4d}  {name}")
+    if args.sigs:
+        for name, rs in rows:
+            if len(rs) > 1 and name.startswith("hpfebe"):
+                print(f"\n{name}:")
+                for r in rs:
+                    print(f"  {r['self_s']:6.2f} s  {r['sig']}")
     if warm["records"]:
         print(f"\nwarm run still compiled {len(warm['records'])} specialisations: "
               + ", ".join(sorted({r['name'].rsplit('.', 1)[-1] for r in warm['records']})))

@@ -28,6 +28,67 @@ class CLIError(Exception):
     """A user-facing error: printed without traceback, exit status 2."""
 
 
+# --------------------------------------------------------------------------- JIT time
+class JitTimer:
+    """Wall time a run spends in numba's JIT, from numba's own events
+    (``numba.core.event``), outermost events only (nested compiles are not counted twice):
+
+    * ``compile_s``: the ``numba:compile`` events - new machine code (a cold numba cache,
+      or a changed source);
+    * ``jit_s``: the ``numba:compiler_lock`` holds - compiling, typing and loading
+      compiled functions from the on-disk cache (the warm-start cost).
+
+    Use as a context manager; :meth:`as_dict` gives the numbers recorded in a result's
+    ``provenance.run`` (``jit_compile_s``, ``jit_s``).  Without numba both stay 0."""
+
+    def __init__(self):
+        self.compile_s = 0.0
+        self.jit_s = 0.0
+        self._listeners = []
+
+    def _listener(self, attr):
+        try:
+            import numba.core.event as ev
+        except ImportError:    # pragma: no cover - numba is a dependency
+            return None
+        timer = self
+
+        class _Outermost(ev.Listener):
+            depth, start = 0, 0.0
+
+            def on_start(self, event):
+                if self.depth == 0:
+                    self.start = time.perf_counter()
+                self.depth += 1
+
+            def on_end(self, event):
+                self.depth -= 1
+                if self.depth == 0:
+                    setattr(timer, attr, getattr(timer, attr)
+                            + time.perf_counter() - self.start)
+
+        return ev, _Outermost()
+
+    def __enter__(self):
+        for kind, attr in (("numba:compile", "compile_s"),
+                           ("numba:compiler_lock", "jit_s")):
+            got = self._listener(attr)
+            if got is not None:
+                ev, lis = got
+                ev.register(kind, lis)
+                self._listeners.append((ev, kind, lis))
+        return self
+
+    def __exit__(self, *exc):
+        for ev, kind, lis in self._listeners:
+            ev.unregister(kind, lis)
+        self._listeners.clear()
+        return False
+
+    def as_dict(self) -> dict:
+        return {"jit_compile_s": round(self.compile_s, 3), "jit_s": round(self.jit_s, 3)}
+
+
 # --------------------------------------------------------------------------- signals
 #: environment variable naming the process whose death stops a run (set by the
 #: Snakefile to the Snakemake process running the job)
@@ -364,11 +425,13 @@ def cmd_run(args) -> int:
 
     t0 = time.perf_counter()
     try:
-        results = module.run(section, quick=quick)
+        with JitTimer() as jit:
+            results = module.run(section, quick=quick)
     except ConfigError as exc:
         raise CLIError(f"config: {exc} ({where_set(per_file, exc.path)})") from None
     wall = time.perf_counter() - t0
-    log.info("%s finished in %.1f s", exp.name, wall)
+    log.info("%s finished in %.1f s (numba: %.1f s compiling, %.1f s in the JIT in all)",
+             exp.name, wall, jit.compile_s, jit.jit_s)
 
     if not isinstance(results, (list, tuple)) or not all(
             isinstance(r, res.ArtefactResult) for r in results):
@@ -389,6 +452,7 @@ def cmd_run(args) -> int:
         "quick": quick,
         "config_files": [str(f) for f in files],
         "module_wall_time_s": round(wall, 3),
+        **jit.as_dict(),
         "argv": sys.argv[1:],
     }
     for r in results:

@@ -8,7 +8,9 @@ writes
     report/report.md    the same content in Markdown (figures linked from results/)
 
 Top: a summary (artefact, kind, status, cells within tolerance, claims holding /
-differing, wall time).  Per table artefact with a published file: published |
+differing, wall time), then a timing table: one line per module with its wall time,
+numba compile time and JIT time (``provenance.run`` of the results, written by the
+command line's :class:`hpfebe.cli.JitTimer`; older results show "-").  Per table artefact with a published file: published |
 reproduced | difference | status for every column with a tolerance, joined on the
 result's ``keys`` (rows on one side only are marked "not run" / "not published").
 Per artefact: the figure, the thesis's claims with verdict and evidence, the notes, the
@@ -96,6 +98,27 @@ class Entry:
             return float(t)
         except (TypeError, ValueError):
             return None
+
+    def _run_number(self, key: str, meta_key: str | None = None) -> float | None:
+        if not self.doc:
+            return None
+        t = ((self.doc.get("provenance") or {}).get("run") or {}).get(key)
+        if t is None and meta_key:
+            t = (self.doc.get("meta") or {}).get(meta_key)
+        try:
+            return float(t)
+        except (TypeError, ValueError):
+            return None
+
+    @property
+    def compile_time(self) -> float | None:
+        """Seconds the module's run spent compiling numba code (None: not recorded)."""
+        return self._run_number("jit_compile_s", "jit_s")
+
+    @property
+    def jit_time(self) -> float | None:
+        """Seconds in numba's JIT in all (compiling and loading from its cache)."""
+        return self._run_number("jit_s")
 
     @property
     def quick(self) -> bool | None:
@@ -397,6 +420,42 @@ def _comparison_table(cmp: Comparison):
     return header, rows
 
 
+TIMING_HEADER = ["module", "artefacts", "run time [s]", "numba compile [s]",
+                 "numba JIT incl. cache loads [s]"]
+
+
+def _fmt_s(t) -> str:
+    return "-" if t is None else f"{t:.1f}"
+
+
+def _timing_rows(entries):
+    """One row per module: its artefacts, the module's wall time (one run makes all its
+    artefacts), the time numba spent compiling and in its JIT in all (cold numba cache:
+    compile ~ JIT; warm: compile 0, JIT = cache loading).  Totals in the last row."""
+    mods: dict[str, list] = {}
+    for e in entries:
+        if e.doc is not None and e.module:
+            mods.setdefault(e.module, []).append(e)
+    rows, tot = [], [0.0, 0.0, 0.0]
+    for mod in sorted(mods):
+        es = mods[mod]
+        vals = [max((x for x in (f(e) for e in es) if x is not None), default=None)
+                for f in (lambda e: e.wall_time, lambda e: e.compile_time,
+                          lambda e: e.jit_time)]
+        rows.append([mod, ", ".join(e.name for e in es)] + [_fmt_s(v) for v in vals])
+        tot = [t + (v or 0.0) for t, v in zip(tot, vals)]
+    if rows:
+        rows.append(["all modules (sum)", f"{len(rows)} modules"] + [f"{t:.1f}" for t in tot])
+    return rows
+
+
+TIMING_INTRO = ("Per module (one run makes all its artefacts): wall time of the run, the "
+                "part numba spent compiling (new machine code: cold cache), and the time "
+                "in numba's JIT in all (compiling plus loading compiled code from the "
+                "on-disk cache). The sum is serial time; snakemake -j2 runs two modules "
+                "at once.")
+
+
 def _provenance_summary(entries) -> dict:
     docs = [e.doc for e in entries if e.doc]
     provs = [d.get("provenance") or {} for d in docs]
@@ -454,6 +513,9 @@ def render_markdown(entries, out_dir: Path, results_dir: Path) -> str:
         L += ["> **Quick configuration**: sweeps are reduced (config/quick.yaml); rows "
               "marked 'not run' are expected.", ""]
     L += ["## Summary", "", _md_table(SUMMARY_HEADER, _summary_rows(entries)), ""]
+    timing = _timing_rows(entries)
+    if timing:
+        L += ["## Timing", "", TIMING_INTRO, "", _md_table(TIMING_HEADER, timing), ""]
     for e in entries:
         L += [f"## {e.name}", "", f"*{e.kind}* - module `{e.module or '-'}` - "
               f"status: **{e.status}**", ""]
@@ -560,6 +622,10 @@ def render_html(entries) -> str:
         tbl = tbl.replace(f'<td class="l">{_e(e.name)}</td>',
                           f'<td class="l"><a href="#{_e(e.name)}">{_e(e.name)}</a></td>', 1)
     H.append(tbl)
+    timing = _timing_rows(entries)
+    if timing:
+        H += ["<h2 id='timing'>Timing</h2>", f"<p>{_e(TIMING_INTRO)}</p>",
+              _html_table(TIMING_HEADER, timing, left=2)]
 
     for e in entries:
         H.append(f"<h2 id='{_e(e.name)}'>{_e(e.name)}</h2>")

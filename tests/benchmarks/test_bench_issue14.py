@@ -99,9 +99,13 @@ def test_two_thread_speedup(benchmark, N):
     mesh = _square(N)
     _vkw(_square(8))
 
+    cpu_per_wall = {}
+
     def run(nt):
         numba.set_num_threads(nt)
+        c0, t0 = time.process_time(), time.perf_counter()
         _vkw(mesh)
+        cpu_per_wall[nt] = (time.process_time() - c0) / (time.perf_counter() - t0)
 
     old = numba.get_num_threads()
     try:
@@ -109,7 +113,52 @@ def test_two_thread_speedup(benchmark, N):
                                 repeat=3 if N <= 1024 else 1)
     finally:
         numba.set_num_threads(old)
-    benchmark.extra_info.update(N=N, t1_s=best[1], t2_s=best[2], speedup=best[1] / best[2])
+    # cpu/wall of the 2-thread run below ~1.8: the machine did not give this process two
+    # cores (other busy sessions; with sched_autogroup the cores are shared per session,
+    # not per thread), and the speed-up says nothing about the code: see
+    # test_two_thread_balance for the load-free figure
+    benchmark.extra_info.update(N=N, t1_s=best[1], t2_s=best[2], speedup=best[1] / best[2],
+                                cpu_per_wall_1=cpu_per_wall[1],
+                                cpu_per_wall_2=cpu_per_wall[2])
+    benchmark.pedantic(lambda: None, rounds=1, iterations=1)
+
+
+@pytest.mark.parametrize("N", [1024, 4096])
+def test_two_thread_balance(benchmark, N, monkeypatch):
+    """Load balance of the parallel row loop, measured on one thread (so that a busy
+    machine does not decide it): the row chunks that 2 threads get under numba's static
+    schedule (4 per thread) are timed one by one, and total / max(per-thread sum) is the
+    speed-up 2 threads reach on an idle machine if nothing else were serial (the
+    remaining serial work - Python around the kernels, T, the finiteness check - is under
+    1 % at these sizes).  Recorded; the measured one is test_two_thread_speedup."""
+    from hpfebe.bem import assembly
+
+    old = numba.get_num_threads()
+    numba.set_num_threads(1)
+    calls = []
+    orig = assembly._assemble_rows
+
+    def capture(*args):
+        calls.append(args)
+        return orig(*args)
+
+    try:
+        monkeypatch.setattr(assembly, "_assemble_rows", capture)
+        _vkw(_square(N))
+        monkeypatch.setattr(assembly, "_assemble_rows", orig)
+        info = {}
+        for name, args in zip(("V", "K"), calls):
+            rows = args[-2]
+            starts = np.linspace(0, len(rows), 9).round().astype(np.int64)
+            fs = {c: (lambda c=c: orig(*args[:-2], rows[starts[c]:starts[c + 1]],
+                                       np.array([0, starts[c + 1] - starts[c]])))
+                  for c in range(8)}
+            best = _min_interleaved(fs, repeat=3 if N <= 1024 else 2)
+            t = np.array([best[c] for c in range(8)])
+            info[f"{name}_predicted_speedup"] = t.sum() / max(t[:4].sum(), t[4:].sum())
+    finally:
+        numba.set_num_threads(old)
+    benchmark.extra_info.update(N=N, **info)
     benchmark.pedantic(lambda: None, rounds=1, iterations=1)
 
 

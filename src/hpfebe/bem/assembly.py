@@ -8,6 +8,11 @@ and scattered.  Rows belong to test elements, so the loop over test elements run
 parallel without write conflicts (the test space must be discontinuous: W_hp): a numba
 parallel loop over chunks of rows (the mirror of the upper triangle and the
 sandwich W = T^T V T run as ``nogil`` kernels on Python threads: no parfor to compile).
+
+Caching: numba's on-disk cache keys a function on the contents of its own file only, so
+the cached ``_assemble_rows`` keeps the machine code of the :mod:`.integration` and
+:mod:`.kernels` functions it was compiled with.  After changing those files, delete
+``src/hpfebe/bem/__pycache__`` (or point NUMBA_CACHE_DIR elsewhere), or the old code runs.
 """
 
 from __future__ import annotations
@@ -20,11 +25,11 @@ import numba
 import numpy as np
 from numba import njit, prange
 
-from ..quadrature import rule_tables
+from ..quadrature import gauss_legendre, gauss_log
 from ..spaces import P_MAX, DiscontinuousSpace, eval_basis, gll_tables, n_local
 from .integration import (ETA, NMAX, TOL, adjacent_block, coincident_block, far_block,
                           nearest_ends)
-from .kernels import kernel_batch
+from .kernels import LAPLACE_DL, kernel_batch
 
 
 @njit(cache=True)
@@ -37,6 +42,19 @@ def _shared_vertex(elements, i, j):
             if elements[i, q] == elements[j, r]:
                 return q, r
     return -1, -1
+
+
+@njit(cache=True)
+def _collinear(nodes, elements, normals, i, j):
+    """Whether test element i lies on the line of trial element j (to 1e-15 of the
+    distances): there (x - y) . n_y = 0, the Laplace double layer kernel vanishes and
+    the block is exactly 0 (a quarter of all pairs on a polygon side, p = 1)."""
+    aI, bI, aJ = nodes[elements[i, 0]], nodes[elements[i, 1]], nodes[elements[j, 0]]
+    nJ = normals[j]
+    d0 = (aI[0] - aJ[0]) * nJ[0] + (aI[1] - aJ[1]) * nJ[1]
+    d1 = (bI[0] - aJ[0]) * nJ[0] + (bI[1] - aJ[1]) * nJ[1]
+    return (abs(d0) <= 1e-15 * math.hypot(aI[0] - aJ[0], aI[1] - aJ[1])
+            and abs(d1) <= 1e-15 * math.hypot(bI[0] - aJ[0], bI[1] - aJ[1]))
 
 
 @njit(cache=True)
@@ -92,6 +110,8 @@ def _assemble_rows(kernel, logc, haslog, kp, d, nodes, elements, normals, L, mid
             mt = n_local(kt, pt)
             aI, bI = nodes[elements[i, 0]], nodes[elements[i, 1]]
             for j in range(j0, ne):
+                if kernel == LAPLACE_DL and _collinear(nodes, elements, normals, i, j):
+                    continue      # block 0: nothing to add to out
                 pr = degr[j]
                 mr = n_local(kr, pr)
                 # fast path for well separated pairs (most of them): the lower bound
@@ -225,6 +245,36 @@ def _mirror_upper(A: np.ndarray) -> None:
     _threaded(_mirror_rows, (A,), _interleaved(nb), 0.5 * A.shape[0] ** 2 / 64)
 
 
+@lru_cache(maxsize=None)
+def rules(n_log: int = 0):
+    """(gx, gw, lx, lw) as :func:`hpfebe.quadrature.rule_tables` (NMAX) packs them
+    (bitwise the same entries), but with the log-weighted rules only for n <= ``n_log``
+    (zero rows above): those are what the singular integration of degree p <= pmax reads
+    (n_log = pmax + 2), and building all 48 costs ~0.5-1 s of Python at the first call
+    of a process (Gautschi's algorithm per n), most of a warm start."""
+    gx = np.zeros((NMAX + 1, NMAX))
+    gw = np.zeros((NMAX + 1, NMAX))
+    lx = np.zeros((NMAX + 1, NMAX))
+    lw = np.zeros((NMAX + 1, NMAX))
+    for n in range(1, NMAX + 1):
+        x, w = gauss_legendre(n)
+        gx[n, :n] = 0.5 * (x + 1.0)
+        gw[n, :n] = 0.5 * w
+    for n in range(1, min(n_log, NMAX) + 1):
+        x, w = gauss_log(n)
+        lx[n, :n] = x
+        lw[n, :n] = w
+    for t in (gx, gw, lx, lw):
+        t.setflags(write=False)
+    return gx, gw, lx, lw
+
+
+def log_rule_count(pmax: int) -> int:
+    """Largest log-weighted Gauss order the integration reads for degrees <= pmax: the
+    nl = (deg + 3) // 2 + 1 of :mod:`.integration`, deg <= 2 pmax."""
+    return (2 * pmax + 3) // 2 + 1
+
+
 NTAB = 12  # far pairs needing fewer Gauss points than this use tabulated basis values
 
 
@@ -233,7 +283,7 @@ def _far_tables(kind: int, pmax: int):
     """Basis values tab[p, n, a, k] at the n-point Gauss nodes (on [0,1]) for degrees
     p <= pmax, and order thresholds thr[deg, n]: the smallest distance/half-length ratio
     for which n points meet integration.TOL (the inverse of integration._order)."""
-    gx, _, _, _ = rule_tables(NMAX)
+    gx = rules()[0]
     gll_x, gll_b = gll_tables(P_MAX)
     tab = np.zeros((pmax + 1, NTAB + 1, NTAB, pmax + 1))
     for p in range(1, pmax + 1):
@@ -280,7 +330,7 @@ def assemble(kernel: int, logc, kp, test, trial, d: int = 1,
     mesh = test.mesh
     if mesh.degrees.max() > P_MAX:
         raise ValueError(f"degree p must be <= {P_MAX}, got {mesh.degrees.max()}")
-    gx, gw, lx, lw = rule_tables(NMAX)
+    gx, gw, lx, lw = rules(log_rule_count(int(mesh.degrees.max())))
     gll_x, gll_b = gll_tables(P_MAX)
     logc = np.ascontiguousarray(np.asarray(logc, dtype=float).reshape(d * d))
     kp = np.ascontiguousarray(np.asarray(kp, dtype=float).reshape(-1))
@@ -314,7 +364,7 @@ def local_block(kernel, logc, kp, mesh, i: int, j: int, test_kind: int, trial_ki
     """Local block of the pair (test element i, trial element j) with basis kinds
     0 (Legendre, W_hp) or 1 (GLL Lagrange, V_hp) at the elements' degrees, by the same
     integration functions as :func:`assemble` uses for near pairs; for tests."""
-    gx, gw, lx, lw = rule_tables(NMAX)
+    gx, gw, lx, lw = rules(log_rule_count(int(mesh.degrees.max())))
     gll_x, gll_b = gll_tables(P_MAX)
     logc = np.ascontiguousarray(np.asarray(logc, dtype=float).reshape(d * d))
     kp = np.ascontiguousarray(np.asarray(kp, dtype=float).reshape(-1))

@@ -24,7 +24,9 @@ function each (the split of HILBERT and the ETH 2D parametric BEM code):
   n = ln(1/tol) / (2 ln rho) + (degree + 1)/2.
 
 ``kernel`` is an integer id of :mod:`hpfebe.bem.kernels`; the regular part k_reg is
-evaluated by ``kernel_batch`` once per batch of quadrature points, ``logc`` is the (d*d)
+evaluated by ``kernel_batch`` once per batch of quadrature points (single points pass
+``np.int64(1)`` as the count: a literal 1 compiled the six kernel functions a second
+time, for Literal[int](1) - 2 s of a cold start), ``logc`` is the (d*d)
 array of the log coefficients A.
 """
 
@@ -361,7 +363,7 @@ def parallel_block(kernel, logc, haslog, kp, d, aI, bI, nI, aJ, bJ, nJ, s0, s1, 
                 continue
             rxs[0] = z * tx - wx_
             rys[0] = z * ty - wy_
-            kernel_batch(kernel, rxs, rys, 1, nI, nJ, kp, Kq)
+            kernel_batch(kernel, rxs, rys, np.int64(1), nI, nJ, kp, Kq)
             if haslog:
                 lr = 0.5 * math.log(rxs[0] * rxs[0] + rys[0] * rys[0])
                 for c in range(dd):
@@ -427,7 +429,7 @@ def coincident_block(kernel, logc, haslog, kp, d, aI, bI, nI, kt, pt, kr, pr,
                     if part == 0:
                         rxs[0] = sgn * z * L * ex
                         rys[0] = sgn * z * L * ey
-                        kernel_batch(kernel, rxs, rys, 1, nI, nI, kp, Kq)
+                        kernel_batch(kernel, rxs, rys, np.int64(1), nI, nI, kp, Kq)
                         if haslog:
                             for c in range(dd):
                                 Kq[0, c] += logc[c] * logL
@@ -509,6 +511,10 @@ def adjacent_block(kernel, logc, haslog, kp, d, aI, bI, nI, aJ, bJ, nJ, vI, vJ,
             if part == 1 and not haslog:
                 break
             nuu = nu if part == 0 else nl
+            # the log u part is logc times a polynomial of degree degw in w (no
+            # singularity in w): Gauss with degw // 2 + 1 points is exact, where the
+            # graded rule of part 0 spends ~11-13
+            nwp = nw if part == 0 else degw // 2 + 1
             for iu in range(nuu):
                 if part == 0:
                     u = gx[nu, iu]
@@ -516,14 +522,18 @@ def adjacent_block(kernel, logc, haslog, kp, d, aI, bI, nI, aJ, bJ, nJ, vI, vJ,
                 else:
                     u = lx[nl, iu]
                     wu = -lw[nl, iu]
-                for iw in range(nw):
-                    w = wx[iw]
+                for iw in range(nwp):
+                    if part == 0:
+                        w = wx[iw]
+                        wt = wu * ww[iw] * u * ell * ell
+                    else:
+                        w = gx[nwp, iw]
+                        wt = wu * gw[nwp, iw] * u * ell * ell
                     # local distances from v (fractions of ell) on I and J
                     if tri == 0:
                         a_loc, b_loc = u, u * w
                     else:
                         a_loc, b_loc = u * w, u
-                    wt = wu * ww[iw] * u * ell * ell
                     s = a_loc * fI if vI == 0 else 1.0 - a_loc * fI
                     g = b_loc * fJ if vJ == 0 else 1.0 - b_loc * fJ
                     eval_basis(kt, pt, 2.0 * s - 1.0, gll_x, gll_b, phi)
@@ -531,7 +541,7 @@ def adjacent_block(kernel, logc, haslog, kp, d, aI, bI, nI, aJ, bJ, nJ, vI, vJ,
                     if part == 0:
                         rxs[0] = ell * (a_loc * dIx - b_loc * dJx)
                         rys[0] = ell * (a_loc * dIy - b_loc * dJy)
-                        kernel_batch(kernel, rxs, rys, 1, nI, nJ, kp, Kq)
+                        kernel_batch(kernel, rxs, rys, np.int64(1), nI, nJ, kp, Kq)
                         if haslog:
                             if tri == 0:
                                 R = math.hypot(dIx - w * dJx, dIy - w * dJy)

@@ -70,7 +70,7 @@ from ..spaces import ContinuousSpace, DiscontinuousSpace
 from .assembly import assemble, local_block, sandwich
 from .kernels import (KP_C1, KP_C1_C2, KP_C1_LOG_R, KP_C2, KP_ET, KP_ET_LOG_R, KP_LAMBDA,
                       KP_LAME_SIZE, KP_MU, LAME_DL, LAME_HS, LAME_SL)
-from .operators import BoundaryOperators
+from .operators import BoundaryOperators, mesh_diameter
 from .potentials import (POT_LAME_DL, POT_LAME_DL_GRAD, POT_LAME_SL, POT_LAME_SL_GRAD,
                          evaluate_potential)
 
@@ -151,7 +151,7 @@ class LameBEM(BoundaryOperators):
         self.E, self.nu, self.plane = float(E), float(nu), plane
         self.lam, self.mu = lame_constants(E, nu, plane)
         if isinstance(mesh, BoundaryMesh) and scale is None:
-            scale = 2.0 * mesh.diameter
+            scale = 2.0 * mesh_diameter(mesh)
         super().__init__(mesh, scale, constrained=zero_force)
         self.zero_force = self.constrained
         self.kp = _checked_kernel_params(E, nu, self.lam, self.mu, self.scale)

@@ -47,7 +47,7 @@ from ..geometry import BoundaryMesh
 from ..spaces import ContinuousSpace, DiscontinuousSpace
 from .assembly import assemble, sandwich
 from .kernels import INV_2PI, KP_LAPLACE_LOG_R, LAPLACE_DL, LAPLACE_SL
-from .operators import BoundaryOperators
+from .operators import BoundaryOperators, mesh_diameter
 from .potentials import POT_LAPLACE_DL, POT_LAPLACE_SL, evaluate_potential
 
 SINGLE_LAYER_LOGC = np.array([-INV_2PI])
@@ -78,7 +78,7 @@ class LaplaceBEM(BoundaryOperators):
     def __init__(self, mesh: BoundaryMesh, scale: float | None = None,
                  zero_flux: bool = True):
         if isinstance(mesh, BoundaryMesh) and scale is None:
-            scale = mesh.diameter
+            scale = mesh_diameter(mesh)
         super().__init__(mesh, scale, constrained=zero_flux)
         self.zero_flux = self.constrained
         self.kp = _scale_param(self.scale)

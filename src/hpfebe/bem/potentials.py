@@ -19,9 +19,9 @@ import math
 import numpy as np
 from numba import njit, prange
 
-from ..quadrature import rule_tables
 from ..spaces import P_MAX, eval_basis, gll_tables, n_local
-from .integration import NMAX, _order, point_panels
+from .assembly import rules
+from .integration import _order, point_panels
 from .kernels import (INV_2PI, KP_C1, KP_C1_C2, KP_C1_LOG_R, KP_C2, KP_LAMBDA,
                       KP_LAPLACE_LOG_R, KP_MU, _log_rr, _traction_of_G)
 
@@ -186,7 +186,7 @@ def evaluate_potential(kid: int, kp, d: int, points, space, coeffs, nout: int | 
     if coef.shape[0] != space.ndof:
         raise ValueError(f"coeffs must have {space.ndof * d} entries, got {coef.size}")
     mesh = space.mesh
-    gx, gw, _, _ = rule_tables(NMAX)
+    gx, gw, _, _ = rules()
     gll_x, gll_b = gll_tables(P_MAX)
     kp = np.ascontiguousarray(np.asarray(kp, dtype=float).reshape(-1))
     out = _potential(int(kid), kp, d, nout, pts, mesh.nodes, mesh.elements,
