@@ -6,7 +6,8 @@ of the scene; non-convergence of DtN is detected for a diverging damping pair.""
 import numpy as np
 import pytest
 
-from hpfebe.contact.mortar_fe import FEMortarContact, fe_trace_mesh, section44_scene
+from hpfebe.contact.mortar_fe import (READINGS, FEMortarContact, fe_trace_mesh,
+                                      section44_scene)
 from hpfebe.fem.elasticity import rectangle_mesh
 
 
@@ -50,6 +51,15 @@ def test_dtn_default_tolerances_close_to_monolithic(scene, mono):
     # Uzawa: several iterations in the first DtN iteration, then at most 2
     uz = [s.counts["uzawa"] for s in sol.info.steps]
     assert uz[0] >= 2 and max(uz[1:]) <= 2
+    # every reading of the stopping rule recorded per iteration; the fixed_point stop
+    # (relative to the new P) and the printed one (relative to the previous P) agree
+    rd = sol.info.counts["readings"]
+    assert set(rd) == set(READINGS)
+    assert all(len(v) == sol.info.iterations for v in rd.values())
+    assert np.allclose(rd["P_l2_new"], sol.info.counts["relative_increments"])
+    assert np.isinf(rd["P_l2_prev"][0]) and np.isinf(rd["U2_l2_prev"][0])   # P_0 = 0
+    first = lambda v: int(np.flatnonzero(np.asarray(v) <= 1e-6)[0]) + 1  # noqa: E731
+    assert first(rd["P_l2_prev"]) == first(rd["P_l2_new"]) == sol.info.iterations
 
 
 def test_divergence_detected(scene):

@@ -30,6 +30,8 @@ def test_table_4_3_quick(quick_run):
     assert np.allclose(tab.inv_eps_n_over_E, [20, 10, 5, 2.5])
     assert np.allclose(tab.inv_eps_t_over_E, 0.5 * tab.inv_eps_n_over_E)
     assert tab.converged.all()
+    # the penalty work piece is the mortar's (16 x 8 Q1 cells in the quick config)
+    assert (tab.dof_fe == 2 * 17 * 9).all()
     # an order of magnitude fewer Newton iterations than the thesis's 175-520
     assert (tab.newton_iterations > 0).all() and (tab.newton_iterations < 50).all()
     # penetration decreases and is ~linear in eps_n = 1 / (f E)
@@ -72,6 +74,9 @@ def test_table_4_2_quick(quick_run):
     meta = json.loads((quick_run / "table_4_2.json").read_text())
     mono = [c for c in meta["claims"] if "monolithic" in c["text"]]
     assert mono and mono[0]["holds"] is True
+    # the stopping-rule readings: the printed rule (relative to P^k-1) gives the counts
+    assert (ok.its_P_l2_prev == ok.dtn_iterations).all()
+    assert "Stopping-rule readings" in meta["notes"]
 
 
 def test_figure_4_21_quick(quick_run):
@@ -85,5 +90,12 @@ def test_figure_4_21_quick(quick_run):
     diff = df[df.quantity == "mortar_vs_penalty"]
     assert set(diff.field) == {"u_x", "u_y", "dev_sigma_norm"}
     assert (diff.rel_l2 >= 0).all() and (diff.rel_l2 < 1).all()
+    # the comparison on the same work piece mesh: its nodes and cells are the mortar's
+    # (4 x 2 rectangle, 16 x 8 cells in the quick config), and its split into variants
+    main = diff[diff.variant == "main"].set_index(["body", "field"])
+    assert main.loc[("work", "u_x"), "n_points"] == 17 * 9
+    assert main.loc[("work", "dev_sigma_norm"), "n_points"] == 16 * 8
+    assert {"main", "frictionless", "friction_mortar", "friction_penalty", "penalty_bbar",
+            "penalty_bbar_h_work"} <= set(diff.variant)
     meta = json.loads((quick_run / "figure_4_21.json").read_text())
     assert any("penalty" in c["text"] for c in meta["claims"])

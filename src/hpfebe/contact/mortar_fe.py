@@ -52,6 +52,16 @@ from .mortar import (CondensedBody, MortarContact, MortarSolution, _check_omega,
 
 SIDES = ("bottom", "right", "top", "left")
 
+#: Readings of the DtN stopping rule (Algorithm 4.3, step 7: "stop if ||P^k - P^k-1|| <=
+#: TOL_DtN ||P^k-1||"), recorded per iteration by :meth:`FEMortarContact.dtn` in
+#: ``info.counts["readings"]``: the quantity (P: the transferred traction functional on
+#: Gamma^2_C; U2: the work piece's displacement of step 2), the norm (l2 / max of the
+#: coefficient vector, L2(Gamma_C) of the function M2^-1 P, the elastic energy norm of
+#: U2, U2 on Gamma^2_C) and the reference (the previous iterate - the printed rule -, the
+#: new one - :func:`hpfebe.nonlinear.fixed_point`'s -, or the first nonzero P).
+READINGS = ("P_l2_prev", "P_l2_new", "P_max_prev", "P_L2gamma_prev", "P_l2_first",
+            "U2_l2_prev", "U2_max_prev", "U2_energy_prev", "U2_contact_prev")
+
 
 # --------------------------------------------------------------------------- traces
 def fe_trace_mesh(mesh, contact: str):
@@ -237,11 +247,14 @@ class FEMortarContact(MortarContact):
            iteration),
         5. R1 = S1 U1 - L1 on Gamma^1_C,
         6. P_{k+1} = (1 - omega_N) P_k + omega_N B^T D^-T R1,
-        7. stop if ||P_{k+1} - P_k|| <= TOL ||P_{k+1}|| (:func:`fixed_point`; growth of
-           the increment by ``divergence``, a failed Newton or Uzawa solve or
-           ``max_iter`` end it with the reason); converged only if also the obstacle
-           matches the work piece, ||Q_n - (pi U2)_n||_inf <= ``coupling_tol``
-           ||(pi U2)_n||_inf (``info.backward_error``).
+        7. stop if ||P_{k+1} - P_k||_2 <= TOL ||P_{k+1}||_2 (:func:`fixed_point`; the
+           thesis divides by ||P_k||, the previous iterate: the two thresholds differ by
+           a factor 1 + O(TOL), the counts are the same - measured on Table 4.2, every
+           reading in ``info.counts["readings"]``, :data:`READINGS`; growth of the
+           increment by ``divergence``, a failed Newton or Uzawa solve or ``max_iter``
+           end it with the reason); converged only if also the obstacle matches the
+           work piece, ||Q_n - (pi U2)_n||_inf <= ``coupling_tol`` ||(pi U2)_n||_inf
+           (``info.backward_error``).
 
         ``newton_tol``: the Newton tolerance of step 2 (||R||_inf <= newton_tol x (force
         scale + :attr:`force_floor`)); the thesis's TOL_N = 1e-4 in this norm leaves
@@ -277,14 +290,15 @@ class FEMortarContact(MortarContact):
         m = self.mortar
         load2 = m.pair2 if transfer == "function" else (lambda P: P)
         to_P = (lambda R1: m.adjoint(m.riesz(R1))) if transfer == "function" else m.adjoint
-        st = dict(Q=np.zeros(2 * self.nc), lam=np.zeros(self.nc), x=None, u2=None, pn=[])
+        st = dict(Q=np.zeros(2 * self.nc), lam=np.zeros(self.nc), x=None, u2=None, pn=[],
+                  first=None, readings={k: [] for k in READINGS})
 
         def update(P):
             u2, ninfo = self.neumann(load2(P), st["u2"], newton_tol, newton_max_iter)
             if not ninfo.converged:
                 return P, SolverInfo(False, f"Neumann problem (Newton): {ninfo.reason}",
                                      steps=[ninfo])
-            st["u2"] = u2
+            u2_old, st["u2"] = st["u2"], u2
             Q = (1.0 - omega_D) * st["Q"] + omega_D * m.project(u2[self.c2])
             x, lam, uinfo = self.uzawa(Q, rho, tol_U, max_uzawa, st["lam"], st["x"],
                                        bound=bound)
@@ -298,6 +312,9 @@ class FEMortarContact(MortarContact):
                 inner.reason = f"Uzawa: {uinfo.reason}"
             P_new = (1.0 - omega_N) * P + omega_N * to_P(R1)
             st["pn"].append(float(np.linalg.norm(P_new)))
+            if st["first"] is None:
+                st["first"] = P_new
+            self._record_readings(st["readings"], P, P_new, st["first"], u2_old, u2)
             return P_new, inner
 
         P, info = fixed_point(update, np.zeros(self.c2.size), tol, max_iter, norm=2,
@@ -307,7 +324,8 @@ class FEMortarContact(MortarContact):
             uzawa_total=int(sum(s.counts.get("uzawa", 0) for s in info.steps)),
             newton_total=int(sum(s.counts.get("newton", 0) for s in info.steps)),
             rho=rho, relative_increments=[
-                r / max(n, np.finfo(float).tiny) for r, n in zip(info.residuals, st["pn"])])
+                r / max(n, np.finfo(float).tiny) for r, n in zip(info.residuals, st["pn"])],
+            readings=st["readings"])
         u2 = st["u2"] if st["u2"] is not None else self.elastic_start(
             np.zeros(self.work.ndofs))
         if info.converged:                       # U2 of the final P (step 2 once more)
@@ -330,6 +348,41 @@ class FEMortarContact(MortarContact):
         return MortarSolution(u1[self.c1], u2[self.c2], st["lam"], st["Q"], P, x, info,
                               extra=dict(u1=u1, u2=u2, force2=load2(P),
                                          fields=self.work_fields(u2)))
+
+    def _record_readings(self, out: dict, P_old, P_new, P_first, u2_old, u2) -> None:
+        """Append the relative increment of DtN iteration k under every reading of the
+        stopping rule (:data:`READINGS`) to ``out`` (inf where the reference is zero or
+        not yet defined: the first iteration has P_0 = 0 and no previous U2)."""
+        def rel(num, den):
+            return float(num / den) if den > 0 else np.inf
+
+        dP = P_new - P_old
+        if not hasattr(self, "_m2_lu"):
+            self._m2_lu = spla.splu(sp.csc_matrix(self.mortar.M2))
+            self._K2e = self.work.K.tocsr()
+
+        def l2_gamma(v):                    # ||M2^-1 v||_L2(Gamma_C) of a functional v
+            V = v.reshape(-1, 2)
+            return float(np.sqrt(max((self._m2_lu.solve(V) * V).sum(), 0.0)))
+
+        def energy(v):
+            return float(np.sqrt(max(v @ (self._K2e @ v), 0.0)))
+
+        out["P_l2_prev"].append(rel(np.linalg.norm(dP), np.linalg.norm(P_old)))
+        out["P_l2_new"].append(rel(np.linalg.norm(dP), np.linalg.norm(P_new)))
+        out["P_max_prev"].append(rel(np.abs(dP).max(), np.abs(P_old).max()))
+        out["P_L2gamma_prev"].append(rel(l2_gamma(dP), l2_gamma(P_old)))
+        out["P_l2_first"].append(rel(np.linalg.norm(dP), np.linalg.norm(P_first)))
+        if u2_old is None:
+            for k in ("U2_l2_prev", "U2_max_prev", "U2_energy_prev", "U2_contact_prev"):
+                out[k].append(np.inf)
+            return
+        dU = u2 - u2_old
+        out["U2_l2_prev"].append(rel(np.linalg.norm(dU), np.linalg.norm(u2_old)))
+        out["U2_max_prev"].append(rel(np.abs(dU).max(), np.abs(u2_old).max()))
+        out["U2_energy_prev"].append(rel(energy(dU), energy(u2_old)))
+        out["U2_contact_prev"].append(rel(np.linalg.norm(dU[self.c2]),
+                                          np.linalg.norm(u2_old[self.c2])))
 
     # ---------------------------------------------------------------- monolithic
     def monolithic(self, tol: float = 1e-10, max_iter: int = 60,
@@ -470,4 +523,4 @@ def section44_scene(stamp_cells=(10, 20), work_cells=(61, 31), E: float = 266926
     return FEMortarContact(stamp, work, ("top", (0.0, 0.0)), ("bottom", (0.0, lift)), F)
 
 
-__all__ = ["FEMortarContact", "fe_trace_mesh", "section44_scene"]
+__all__ = ["FEMortarContact", "READINGS", "fe_trace_mesh", "section44_scene"]
