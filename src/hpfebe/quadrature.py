@@ -113,11 +113,13 @@ def gauss_log(n: int) -> tuple[np.ndarray, np.ndarray]:
 
 
 @lru_cache(maxsize=None)
-def rule_tables(nmax: int, log: bool = True):
+def rule_tables(nmax: int, n_log: int | None = None):
     """Gauss-Legendre and log-weighted rules with 1..nmax points, mapped to [0, 1], packed
     row-wise: ``gx[n, :n]``, ``gw[n, :n]`` (Gauss on [0,1]) and ``lx[n, :n]``, ``lw[n, :n]``
-    (weight -log t on (0,1]).  ``log=False`` leaves the log tables zero: building them
-    costs about 1 s at nmax = 48, and only the singular BEM integrals use them."""
+    (weight -log t on (0,1]), the log rules only for n <= ``n_log`` (default nmax; zero
+    rows above): building all 48 costs about 1 s of Python (Gautschi's algorithm per n),
+    and only the singular BEM integrals read them."""
+    n_log = nmax if n_log is None else min(n_log, nmax)
     gx = np.zeros((nmax + 1, nmax))
     gw = np.zeros((nmax + 1, nmax))
     lx = np.zeros((nmax + 1, nmax))
@@ -126,10 +128,10 @@ def rule_tables(nmax: int, log: bool = True):
         x, w = gauss_legendre(n)
         gx[n, :n] = 0.5 * (x + 1.0)
         gw[n, :n] = 0.5 * w
-        if log:
-            x, w = gauss_log(n)
-            lx[n, :n] = x
-            lw[n, :n] = w
+    for n in range(1, n_log + 1):
+        x, w = gauss_log(n)
+        lx[n, :n] = x
+        lw[n, :n] = w
     for t in (gx, gw, lx, lw):
         t.setflags(write=False)
     return gx, gw, lx, lw

@@ -25,7 +25,7 @@ import numba
 import numpy as np
 from numba import njit, prange
 
-from ..quadrature import gauss_legendre, gauss_log
+from ..quadrature import rule_tables
 from ..spaces import P_MAX, DiscontinuousSpace, eval_basis, gll_tables, n_local
 from .integration import (ETA, NMAX, TOL, adjacent_block, coincident_block, far_block,
                           nearest_ends)
@@ -247,26 +247,11 @@ def _mirror_upper(A: np.ndarray) -> None:
 
 @lru_cache(maxsize=None)
 def rules(n_log: int = 0):
-    """(gx, gw, lx, lw) as :func:`hpfebe.quadrature.rule_tables` (NMAX) packs them
-    (bitwise the same entries), but with the log-weighted rules only for n <= ``n_log``
-    (zero rows above): those are what the singular integration of degree p <= pmax reads
-    (n_log = pmax + 2), and building all 48 costs ~0.5-1 s of Python at the first call
-    of a process (Gautschi's algorithm per n), most of a warm start."""
-    gx = np.zeros((NMAX + 1, NMAX))
-    gw = np.zeros((NMAX + 1, NMAX))
-    lx = np.zeros((NMAX + 1, NMAX))
-    lw = np.zeros((NMAX + 1, NMAX))
-    for n in range(1, NMAX + 1):
-        x, w = gauss_legendre(n)
-        gx[n, :n] = 0.5 * (x + 1.0)
-        gw[n, :n] = 0.5 * w
-    for n in range(1, min(n_log, NMAX) + 1):
-        x, w = gauss_log(n)
-        lx[n, :n] = x
-        lw[n, :n] = w
-    for t in (gx, gw, lx, lw):
-        t.setflags(write=False)
-    return gx, gw, lx, lw
+    """(gx, gw, lx, lw) of :func:`hpfebe.quadrature.rule_tables` (NMAX) with the
+    log-weighted rules only for n <= ``n_log``: those are what the singular integration
+    of degree p <= pmax reads (n_log = pmax + 2), and building all 48 costs ~0.5-1 s of
+    Python at the first call of a process, most of a warm start."""
+    return rule_tables(NMAX, n_log)
 
 
 def log_rule_count(pmax: int) -> int:

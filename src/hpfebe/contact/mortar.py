@@ -327,13 +327,19 @@ class MortarContact:
             np.asarray(normal(self.points), dtype=float)
         if nrm.shape != (nc, 2):
             raise ValueError(f"normal must return ({nc}, 2) normals, got {nrm.shape}")
-        self.n = nrm / np.linalg.norm(nrm, axis=1)[:, None]
         self._normal_fn = normal
-        self.t = np.column_stack([-self.n[:, 1], self.n[:, 0]])
         self._gap_fn = gap
+        self._set_frame(nrm)
         self.gap = self.gap_at(self.points, self.n)
         self.w = self._lobatto_weights(bem1.mesh, bem1.V_space, m.dofs1, label)
-        # rotation to (U_n, U_t) at the contact nodes: x = R u_c
+
+    def _set_frame(self, normals):
+        """The frame (n, t) at the nc contact nodes, the rotation x = R u_c = (U_n, U_t)
+        and body 1's condensed quadratic program in it: A = R A_1 R^T (symmetrised
+        against round-off), b = R b_1."""
+        nc = self.nc
+        self.n = normals / np.linalg.norm(normals, axis=1)[:, None]
+        self.t = np.column_stack([-self.n[:, 1], self.n[:, 0]])
         R = np.zeros((2 * nc, 2 * nc))
         j = np.arange(nc)
         R[j, 2 * j], R[j, 2 * j + 1] = self.n[:, 0], self.n[:, 1]

@@ -147,23 +147,14 @@ class FEMortarContact(MortarContact):
                              "Dirichlet side")
         # the stamp's stiffness condensed onto Gamma^1_C: assembled and factorised once
         self.body1 = CondensedBody(stamp.K.toarray(), fixed1, vals1, self.c1)
-        self.nc = nc = m.dofs1.size
+        self.nc = m.dofs1.size
         ns = SimpleNamespace(mesh=self.mesh1, V_space=space1)
         self.points = self._node_points(ns, m.dofs1)
         nrm = self._default_normals(space1, m.dofs1, "C")
-        self.n = nrm / np.linalg.norm(nrm, axis=1)[:, None]
-        self.t = np.column_stack([-self.n[:, 1], self.n[:, 0]])
         self._normal_fn, self._gap_fn = None, None
+        self._set_frame(nrm)
         self.gap = self.gap_at(self.points, self.n)
         self.w = self._lobatto_weights(self.mesh1, space1, m.dofs1, "C")
-        R = np.zeros((2 * nc, 2 * nc))
-        j = np.arange(nc)
-        R[j, 2 * j], R[j, 2 * j + 1] = self.n[:, 0], self.n[:, 1]
-        R[nc + j, 2 * j], R[nc + j, 2 * j + 1] = self.t[:, 0], self.t[:, 1]
-        self.R = R
-        self.A = R @ self.body1.A @ R.T
-        self.A = 0.5 * (self.A + self.A.T)
-        self.b = R @ self.body1.b
         # body 2's Neumann problem (4.88): prescribed sides, load on Gamma^2_C
         self.steps2 = DisplacementSteps(work, self.fixed2, self.values2, extrapolate=False)
         # the mortar projection as a matrix on interleaved vectors (2 nc x 2 n2c)
