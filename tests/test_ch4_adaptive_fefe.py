@@ -175,3 +175,29 @@ def test_displacement_between_dirichlet_values(quick_run):
     js, t = quick_run[0]["figure_4_16"]
     assert t["uy_min"].min() >= -1e-12 and t["uy_max"].max() <= 5e-4 * (1 + 1e-9)
     assert js["claims"][0]["holds"] is True
+
+
+# ----------------------------------------------------------------------------- LU reuse
+def test_newton_reuses_factorisations_without_changing_the_result(monkeypatch):
+    """LoadSteps keeps the sparse LUs of Newton matrices met before (the semismooth
+    iterates revisit contact patterns): fewer factorisations, bit-identical iterates."""
+    import scipy.sparse.linalg as spla
+
+    from hpfebe.contact import loading
+
+    calls, splu = [], spla.splu
+
+    def counting_splu(A, *args, **kw):
+        calls.append(A.shape[0])
+        return splu(A, *args, **kw)
+
+    monkeypatch.setattr(loading.spla, "splu", counting_splu)
+    _, cached = _solve(_meshes())
+    n_cached = len(calls)
+    calls.clear()
+    monkeypatch.setattr(loading.LoadSteps, "LU_CACHE", 0)     # keeps only the last LU
+    _, fresh = _solve(_meshes())
+    assert len(calls) == sum(fresh.iterations)    # no matrix repeats its predecessor
+    assert n_cached < len(calls)
+    assert list(cached.iterations) == list(fresh.iterations)
+    np.testing.assert_array_equal(cached.U, fresh.U)

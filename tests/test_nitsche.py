@@ -278,3 +278,18 @@ def test_solve_returns_solver_info():
     sol = NitscheFEBE(problem("smooth"), 2, 3, 1).solve()
     assert isinstance(sol.solver, SolverInfo) and sol.solver.converged
     assert sol.solver.residuals[-1] == sol.info["residual"] <= 1e-10
+
+
+def test_schur_lu_symmetric_mode_and_fallback():
+    """The SPD LU of the coercivity Schur complements (minimum degree on A + A^T, diagonal
+    pivots) solves SPD systems, and falls back to partial pivoting on a zero pivot."""
+    import scipy.sparse as sp
+
+    from hpfebe.coupling.coercivity import _spd_lu
+
+    A = sp.random(30, 30, 0.2, random_state=1)
+    A = (A @ A.T + sp.eye(30)).tocsc()
+    b = np.arange(30.0)
+    np.testing.assert_allclose(A @ _spd_lu(A).solve(b), b, atol=1e-12 * np.abs(b).max())
+    swap = sp.csc_matrix(np.array([[0.0, 1.0], [1.0, 0.0]]))
+    np.testing.assert_allclose(_spd_lu(swap).solve(np.array([1.0, 2.0])), [2.0, 1.0])

@@ -7,6 +7,7 @@ convergence (the :class:`hpfebe.nonlinear.LoadStep` and
 
 from __future__ import annotations
 
+import hashlib
 import warnings
 
 import numpy as np
@@ -24,6 +25,12 @@ class LoadSteps:
     """The load steps of :meth:`TwoBodyContact.solve`: the Newton problem at a load
     factor (residual R = K U + f_c(U) - F_ext on the free dofs), its start, and the
     commit of the slip after a converged step (:class:`hpfebe.nonlinear.LoadStep`)."""
+
+    #: factorisations of the sparse Newton matrix kept for reuse (:meth:`_factor`): at
+    #: most this many, and at most LU_CACHE_NNZ nonzeros in their factors together
+    #: (about 12 bytes each: 1e8 ~ 1.2 GB, four LUs of 8e4 dofs)
+    LU_CACHE = 8
+    LU_CACHE_NNZ = 100_000_000
 
     def __init__(self, pr, f_ext, fixed_dofs, fixed_values, merit, initial):
         if merit not in MERITS:
@@ -50,6 +57,7 @@ class LoadSteps:
             self._continue_from(initial)
         self.f, self.w = self.f0, self.w0
         self.detect_cycling = False
+        self._lu = {}      # factorisations of Newton matrices seen (:meth:`_factor`)
 
     def _continue_from(self, initial) -> None:
         pr = self.pr
@@ -150,9 +158,7 @@ class LoadSteps:
         else:
             Af = A[free][:, free].tocsc()
             try:
-                with warnings.catch_warnings():
-                    warnings.simplefilter("ignore", spla.MatrixRankWarning)
-                    d = spla.splu(Af).solve(r)
+                d = self._factor(Af).solve(r)
             except RuntimeError:
                 d = np.full(free.size, np.nan)
             if np.all(np.isfinite(d)) and \
@@ -163,6 +169,34 @@ class LoadSteps:
         dx = np.zeros(pr.ndofs)
         dx[free] = d
         return dx
+
+    def _factor(self, Af: sp.csc_matrix):
+        """splu(Af), reused when the same matrix (bit for bit) was factorised before in
+        these load steps.  The semismooth Newton iterates of consecutive load steps pass
+        through the same contact patterns, and the Newton matrix depends on the pattern
+        only (linear bodies: K + C, C piecewise constant in U), so about half of the
+        factorisations repeat one made before; a repeat gives the identical LU, hence the
+        identical step.  At most ``LU_CACHE`` factorisations with ``LU_CACHE_NNZ``
+        nonzeros are kept (least recently used dropped first)."""
+        Af.sort_indices()
+        digest = hashlib.blake2b(Af.indptr.tobytes(), digest_size=16)
+        digest.update(Af.indices.tobytes())
+        digest.update(Af.data.tobytes())
+        key = (Af.shape, Af.nnz, digest.digest())
+        hit = self._lu.pop(key, None)
+        if hit is not None and np.array_equal(hit[0].indptr, Af.indptr) and \
+                np.array_equal(hit[0].indices, Af.indices) and \
+                np.array_equal(hit[0].data, Af.data):
+            self._lu[key] = hit           # most recently used last
+            return hit[1]
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", spla.MatrixRankWarning)
+            lu = spla.splu(Af)
+        self._lu[key] = (Af, lu)
+        while len(self._lu) > 1 and (len(self._lu) > self.LU_CACHE or sum(
+                v[1].nnz for v in self._lu.values()) > self.LU_CACHE_NNZ):
+            self._lu.pop(next(iter(self._lu)))
+        return lu
 
     def step(self, it: Iterate) -> np.ndarray:
         return self._solve(self.pr.tangent(it.data), -it.residual)

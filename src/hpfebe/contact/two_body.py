@@ -484,12 +484,20 @@ class TwoBodyContact:
         return cs["f_body"] + cs["f_c"], cs
 
     def _blocks(self, Ks, Km):
-        """The block diagonal of the body tangents (4.27)/(4.33): dense without FE body."""
+        """The block diagonal of the body tangents (4.27)/(4.33): dense without FE body.
+        Built once while the bodies return the same tangent objects (linear bodies: their
+        stiffness, at every Newton iterate), rebuilt when a tangent changes (plastic)."""
+        last = getattr(self, "_blocks_last", None)
+        if last is not None and last[0] is Ks and last[1] is Km:
+            return last[2]
         if Km.shape[0] == 0:
-            return Ks if self.dense else sp.csr_matrix(Ks)
-        if self.dense:
-            return sla.block_diag(Ks, Km)
-        return sp.block_diag([sp.csr_matrix(Ks), sp.csr_matrix(Km)], format="csr")
+            out = Ks if self.dense else sp.csr_matrix(Ks)
+        elif self.dense:
+            out = sla.block_diag(Ks, Km)
+        else:
+            out = sp.block_diag([sp.csr_matrix(Ks), sp.csr_matrix(Km)], format="csr")
+        self._blocks_last = (Ks, Km, out)
+        return out
 
     def commit(self, U: np.ndarray) -> None:
         """Commit the bodies' history (plastic state) at a converged U."""
