@@ -119,7 +119,7 @@ def grad_single_layer_on_gamma(space, coeffs, elem, t) -> np.ndarray:
     if coef.size != space.ndof:
         raise ValueError(f"coeffs must have {space.ndof} entries, got {coef.size}")
     mesh = space.mesh
-    gx, gw, _, _ = rule_tables(NMAX)
+    gx, gw, _, _ = rule_tables(NMAX, n_log=0)
     gll_x, gll_b = gll_tables(P_MAX)
     return _grad_sl_on_gamma(elem, t, mesh.nodes, mesh.elements, mesh.degrees,
                              space.elem_dofs, coef, gx, gw, gll_x, gll_b)
