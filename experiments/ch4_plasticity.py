@@ -10,8 +10,9 @@ increments; FE/FE and FE/BE (stamp by the Galerkin BEM, S_hat); deformed meshes 
 ||eps_p|| and ||dev sigma|| against the applied force at X = (-0.9, -1.1).
 Example 2 (figure_4_6 ... figure_4_12): one touch of the stamp [-1, 1] x [-1, 0], lift
 4.2e-3; ||dev sigma|| at X = (1, -1.1).  BE/BE (figure_4_10, figure_4_11 and the BE/BE
-curve of figure_4_12) needs the plastic BE body with Newton potentials (Section 4.2.4),
-which is not implemented: those artefacts say so and their claims are undecided.
+curve of figure_4_12): the plastic BE work piece of Section 4.2.4
+(:mod:`hpfebe.plastic_be`: Newton potentials of a cell-wise constant plastic strain,
+backward Euler update) under a BE stamp, one theta (the first of 'thetas'), mesh bebe_h.
 
 Core: :mod:`hpfebe.fem.plasticity` (return map), :mod:`hpfebe.fem.plastic_body` (B-bar
 Q1 work piece), :mod:`hpfebe.contact.stamping` (touches through
@@ -33,9 +34,10 @@ from matplotlib.figure import Figure
 
 from hpfebe.export import fe_vtu
 from hpfebe.fem.plasticity import J2Material
-from hpfebe.contact.stamping import (ContactSettings, curve_difference, element_areas,
-                                 field_difference, plastic_zone, stamp_body,
-                                 stamp_interior, touch, work_piece, zone_mismatch)
+from hpfebe.contact.stamping import (ContactSettings, be_work_piece, curve_difference,
+                                 element_areas, field_difference, plastic_zone,
+                                 stamp_body, stamp_interior, touch, touch_be, work_piece,
+                                 zone_mismatch)
 from hpfebe.params import from_config
 from hpfebe.results import ArtefactResult, Claim, progress
 
@@ -75,6 +77,29 @@ CHOICES = (
     "line search on ||R||, stop at ||R|| <= rtol x force scale + rtol sigma_Y width; a "
     "failed increment is halved (at most max_cuts times).",
     "Plastic zone = elements with mean ||eps_p|| > zone_tol.",
+    "BE/BE (Example 2; the thesis gives no cells or step rule): the work piece's plastic "
+    "strain is constant on cells of size bebe_h covering it, each grid square split into "
+    "four triangles through its centre (bebe_cells = crossed: constant plastic strain on "
+    "axis-parallel squares locks - its compatible isochoric fields are shears along the "
+    "grid lines, measured 65/33/18 % too stiff on a punch with 4/8/16 squares per unit "
+    "against 2 % with crossed triangles). The plastic strain is updated by backward "
+    "Euler (return map of the cell strains solved with the boundary data, consistent "
+    "tangent) instead of the thesis's forward Euler: with E / sigma_Y = 66700 a lift "
+    "increment of 4.2e-4 is ~30 yield strains and the one-step-lagged plastic strain "
+    "is stiff by the elastic predictor (measured, h = 0.4: stamp reaction 352 with 10 "
+    "increments, 125 with 40, against 24.8 with backward Euler; first order, ~3000 "
+    "increments for 5 %). Loading only (n_load "
+    "increments, no unloading); theta = first of thetas; the interior displacement "
+    "(deformed grid) by the representation formula at the cell nodes. Compared with "
+    "FE/FE on the same grid (bebe_h): ||dev sigma|| at X = mean over the cells touching "
+    "X; ||eps_p|| as element means (the four cells of a square area-averaged). Measured "
+    "beside the figures (theta = 1, 10 increments): at bebe_h = 0.2 (800 cells, ~7.5 min "
+    "on a loaded machine, above the 5 min target, hence 0.4) BE/BE vs FE/FE h = 0.2 "
+    "differs by 1.5 % in the force and 20.3 % in ||dev sigma|| at X (X is 0.1 below the "
+    "stamp corner: the value is mesh dependent, FE/FE moves 15.6 % and 7.7 % between "
+    "h = 0.2, 0.1, 0.05), and the BE/BE h = 0.2 curve lies within 1.5 % of FE/FE h = 0.1 "
+    "and 6.3 % of h = 0.05; its top surface agrees except at the two outer corners "
+    "(u_y 4.27e-3 vs 3.51e-3, 21.6 %).",
 )
 
 
@@ -104,6 +129,9 @@ class Params:
     close_tol: float = 0.05          # curves "very close": max relative difference
     similar_tol: float = 0.2         # fields / zones "similar": relative difference
     locking_study: bool = True
+    bebe: bool = True                # BE/BE of Example 2 (figures 4.10, 4.11, 4.12)
+    bebe_h: float = 0.4              # its mesh and cell size
+    bebe_cells: str = "crossed"
 
     def __post_init__(self):
         if not self.thetas or any(not 0 <= t <= 1 for t in self.thetas):
@@ -111,7 +139,10 @@ class Params:
         if self.h_figure not in self.h_levels:
             raise ValueError(f"h_figure must be one of h_levels {self.h_levels!r}, got "
                              f"{self.h_figure!r}")
-        for name in ("ex1_u", "ex2_u", "magnification", "close_tol", "similar_tol"):
+        if self.bebe_cells not in ("quad", "crossed"):
+            raise ValueError(f"bebe_cells must be 'quad' or 'crossed', got {self.bebe_cells!r}")
+        for name in ("ex1_u", "ex2_u", "magnification", "close_tol", "similar_tol",
+                     "bebe_h"):
             if not getattr(self, name) > 0:
                 raise ValueError(f"{name} must be positive, got {getattr(self, name)!r}")
 
@@ -170,6 +201,26 @@ def all_runs(prm: Params) -> dict:
     if prm.locking_study:
         jobs += [(2, "FE", prm.thetas[0], h, "full") for h in prm.h_levels]
     return {j: run_example(prm, *j) for j in progress(jobs, desc="stamping runs")}
+
+
+def bebe_runs(prm: Params) -> dict:
+    """Example 2 with the BE work piece under a BE stamp (theta = thetas[0], mesh
+    bebe_h), and FE/FE on the same mesh as a same-resolution reference:
+    {"BE/BE": Run, "FE/FE": Run}."""
+    if not prm.bebe:
+        return {}
+    h, th = prm.bebe_h, prm.thetas[0]
+    t0 = time.perf_counter()
+    mat = J2Material(prm.E, prm.nu, prm.sigma_Y, prm.H, th)
+    be = be_work_piece(WORK, h, mat, prm.bebe_cells)
+    body = stamp_body("BE", STAMPS[2][0], h, prm.E, prm.nu, p=1)
+    tr = touch_be(body, be, prm.ex2_u, prm.n_load, POINT[2], prm.settings)
+    if not tr.converged:
+        log.warning("BE/BE theta=%g h=%g: %s", th, h, tr.reason)
+    out = {"BE/BE": Run(2, "BE/BE", th, h, prm.bebe_cells, be, [tr],
+                        time.perf_counter() - t0)}
+    out["FE/FE"] = run_example(prm, 2, "FE", th, h)
+    return out
 
 
 def curve_table(runs: dict, example: int) -> pd.DataFrame:
@@ -298,6 +349,107 @@ def mesh_claim(prm: Params, runs: dict) -> Claim:
                  None if shrink is None else bool(shrink), ev)
 
 
+def _load_curve(run: Run, attr: str = "dev_sigma_X") -> np.ndarray:
+    return np.array([getattr(r, attr) for r in run.records if r.phase == "load"])
+
+
+def bebe_curve_claim(prm: Params, runs: dict, bebe: dict) -> Claim:
+    """BE/BE ||dev sigma|| at X (and the applied force) along the load path against
+    FE/FE on the same mesh, FE/FE and FE/BE at h_figure: max relative differences."""
+    if not bebe:
+        return Claim("the BE/BE curve shows qualitatively similar behaviour", None,
+                     "BE/BE not run (bebe = false)")
+    th, bb = prm.thetas[0], bebe["BE/BE"]
+    refs = {f"FE/FE h={bb.h:g}": bebe["FE/FE"],
+            f"FE/FE h={prm.h_figure:g}": runs[(2, "FE", th, prm.h_figure, "bbar")],
+            f"FE/BE h={prm.h_figure:g}": runs[(2, "BE", th, prm.h_figure, "bbar")]}
+    if not bb.converged:
+        return Claim("the BE/BE curve shows qualitatively similar behaviour", False,
+                     f"BE/BE did not converge: {bb.touches[0].reason}")
+    ds = {k: curve_difference(_load_curve(r), _load_curve(bb)) for k, r in refs.items()}
+    df = {k: curve_difference(_load_curve(r, "force"), _load_curve(bb, "force"))
+          for k, r in refs.items()}
+    ok = ds[f"FE/FE h={bb.h:g}"] <= prm.similar_tol
+    return Claim(f"the BE/BE curve shows qualitatively similar behaviour (max relative "
+                 f"difference of ||dev sigma|| at X to FE/FE on the same mesh <= "
+                 f"{prm.similar_tol:.0%}; theta = {th:g}, h = {bb.h:g}; the finer FE curves "
+                 f"show the mesh dependence of the value at X)", bool(ok),
+                 "max rel. difference of ||dev sigma|| at X, BE/BE vs " +
+                 ", ".join(f"{k}: {v:.2%}" for k, v in ds.items()) +
+                 "; of the applied force: " + ", ".join(f"{k}: {v:.2%}" for k, v in df.items()))
+
+
+def _bebe_vs_fe(bebe: dict):
+    """BE/BE fields and top displacement against FE/FE on the same grid at the peak:
+    (FE element areas, BE ||eps_p|| averaged over the cells in each FE element (area
+    weights; every cell lies in one element), FE element mean ||eps_p||, BE top u_y,
+    FE top u_y)."""
+    be, fe = bebe["BE/BE"].fe, bebe["FE/FE"].fe
+    el = np.array([fe.elements_at(c)[0] for c in be.cells.centroids])
+    sb, sf = bebe["BE/BE"].touches[0].peak, bebe["FE/FE"].touches[0].peak
+    w = np.bincount(el, be.cells.areas, minlength=fe.nel)
+    eb = np.bincount(el, be.cells.areas * sb.fields["eps_p_norm"], minlength=fe.nel) / w
+    ef = sf.fields["eps_p_norm"]
+    nodes = be.cells.nodes
+    top = np.flatnonzero(np.isclose(nodes[:, 1], WORK[3]))
+    xf = fe.mesh.p[:, fe.elastic.boundary_vertices("top")]
+    uf = fe.elastic.nodal_displacement(sf.u_work)[1, fe.elastic.boundary_vertices("top")]
+    ufe = np.interp(nodes[top, 0], xf[0][np.argsort(xf[0])], uf[np.argsort(xf[0])])
+    return w, eb, ef, sb.fields["node_u"][top, 1], ufe
+
+
+def bebe_field_claims(prm: Params, bebe: dict) -> tuple[Claim, Claim]:
+    """Deformed top surface and plastic strain of BE/BE against FE/FE on the same grid
+    at full lift."""
+    if not bebe or not bebe["BE/BE"].converged:
+        why = "BE/BE not run" if not bebe else f"BE/BE failed: {bebe['BE/BE'].touches[0].reason}"
+        return (Claim("BE/BE deformed mesh qualitatively as FE/FE", None, why),
+                Claim("BE/BE ||eps_p|| qualitatively as FE/FE", None, why))
+    w, eb, ef, ub, uf = _bebe_vs_fe(bebe)
+    du = float(np.abs(ub - uf).max() / np.abs(uf).max())
+    l2 = float(np.sqrt(w @ (eb - ef) ** 2 / (w @ ef ** 2)))
+    zb, zf = eb > prm.zone_tol, ef > prm.zone_tol
+    mis = float(w[zb ^ zf].sum() / max(w[zb | zf].sum(), 1e-300))
+    h = bebe["BE/BE"].h
+    return (Claim(f"BE/BE deformed mesh qualitatively as FE/FE (top surface u_y at full "
+                  f"lift within {prm.similar_tol:.0%} of FE/FE on the same mesh)",
+                  bool(du <= prm.similar_tol),
+                  f"h = {h:g}: max |u_y(BE/BE) - u_y(FE/FE)| / max |u_y(FE/FE)| on the "
+                  f"top surface = {du:.2%}"),
+            Claim(f"BE/BE ||eps_p|| qualitatively as FE/FE (L2 difference and plastic zone "
+                  f"mismatch <= {prm.similar_tol:.0%} against FE/FE on the same mesh)",
+                  bool(l2 <= prm.similar_tol and mis <= prm.similar_tol),
+                  f"h = {h:g}, element means: ||eps_p|| L2 difference {l2:.2%}, zone "
+                  f"mismatch {mis:.2%}, "
+                  f"max ||eps_p|| BE/BE {eb.max():.3e} vs FE/FE {ef.max():.3e}"))
+
+
+def bebe_exports(bebe: dict) -> dict:
+    """The BE/BE work piece at full lift on its cell grid: node displacement
+    (representation formula) and the cell fields."""
+    snap = bebe["BE/BE"].touches[0].peak if bebe else None
+    if snap is None:
+        return {}
+    cx = bebe["BE/BE"].fe.cells
+    z = np.zeros((len(cx.nodes), 1))
+    kind = "triangle" if cx.cells.shape[1] == 3 else "quad"
+    cells = {k: [np.asarray(v, dtype=float)] for k, v in snap.fields.items()
+             if k != "node_u"}
+    return {"BEBE_touch1_work": meshio.Mesh(
+        np.hstack([cx.nodes, z]), [(kind, np.asarray(cx.cells))],
+        point_data={"u": np.hstack([snap.fields["node_u"], z])}, cell_data=cells)}
+
+
+def bebe_table(bebe: dict) -> pd.DataFrame:
+    rows = []
+    for name, r in bebe.items():
+        for k, rec in enumerate(r.records):
+            rows.append(dict(example=2, coupling=name, theta=r.theta, h=r.h,
+                             formulation=r.formulation, increment=k + 1,
+                             **asdict(rec)))
+    return pd.DataFrame(rows)
+
+
 # --------------------------------------------------------------------------- plots
 def _polys(p: np.ndarray, cells: np.ndarray) -> np.ndarray:
     return p[cells]                                        # (ncells, nv, 2)
@@ -352,7 +504,38 @@ def field_figure(prm: Params, run: Run, field: str | None, title: str) -> Figure
     return fig
 
 
-def curve_figure(prm: Params, runs: dict, example: int) -> Figure:
+def bebe_figure(prm: Params, bebe: dict, field: str | None, title: str) -> Figure:
+    """BE/BE at full lift: the work piece's cell grid deformed by the displacement at its
+    nodes (representation formula, x magnification), the BE stamp on its auxiliary grid;
+    cells coloured by ``field``."""
+    snap = bebe["BE/BE"].touches[0].peak if bebe else None
+    if snap is None:
+        return missing_figure("BE/BE: no converged state (see the claims)")
+    be, mag = bebe["BE/BE"].fe, prm.magnification
+    fig = Figure(figsize=(5.5, 5.0))
+    ax = fig.subplots()
+    pw = be.cells.nodes + mag * snap.fields["node_u"]
+    ps, us, cs = stamp_interior(snap.stamp, snap.u_stamp, *_grid(snap.stamp, prm))
+    kw = dict(edgecolors="k", linewidths=0.2)
+    if field is None:
+        ax.add_collection(PolyCollection(pw[be.cells.cells], facecolors="lightsteelblue",
+                                         **kw))
+        ax.add_collection(PolyCollection(ps[cs] + mag * us[cs], facecolors="wheat", **kw))
+    else:
+        vals = snap.fields[field]
+        pc = PolyCollection(pw[be.cells.cells], array=vals, cmap="jet", **kw)
+        pc.set_clim(0.0, float(vals.max()) or 1.0)
+        ax.add_collection(pc)
+        ax.add_collection(PolyCollection(ps[cs] + mag * us[cs], facecolors="white", **kw))
+        fig.colorbar(pc, ax=ax, shrink=0.7, label=field.replace("_norm", " norm"))
+    ax.set_xlim(-2.2, 2.2)
+    ax.set_ylim(-3.2, 1.2)
+    ax.set_aspect("equal")
+    ax.set_title(f"{title}, h = {bebe['BE/BE'].h:g}, full lift (x{mag:g})", fontsize=9)
+    return fig
+
+
+def curve_figure(prm: Params, runs: dict, example: int, bebe: dict | None = None) -> Figure:
     th0 = prm.thetas
     ncol = len(th0) + 1
     fig = Figure(figsize=(4.8 * ncol, 4.2))
@@ -368,6 +551,13 @@ def curve_figure(prm: Params, runs: dict, example: int) -> Figure:
                         label=f"FE/{st}, touch {t.records[0].touch}" if t.records else None)
                 if t.records:
                     start = (t.records[-1].force, t.records[-1].dev_sigma_X)
+        if bebe and th == bebe["BE/BE"].theta and bebe["BE/BE"].records:
+            r = bebe["BE/BE"]
+            ax.plot([0.0, *_load_curve(r, "force")], [0.0, *_load_curve(r)], ":^", ms=3,
+                    label=f"BE/BE (h = {r.h:g})")
+            f = bebe["FE/FE"]
+            ax.plot([0.0, *_load_curve(f, "force")], [0.0, *_load_curve(f)], "-", lw=0.8,
+                    color="grey", label=f"FE/FE (h = {f.h:g}, same mesh as BE/BE)")
         ax.set_title(f"theta = {th:g}, h = {prm.h_figure:g}", fontsize=9)
         ax.set_xlabel("applied force (bottom reaction)")
         ax.set_ylabel(f"||dev sigma|| at X = {POINT[example]}")
@@ -419,10 +609,6 @@ def missing_figure(text: str) -> Figure:
 
 
 # --------------------------------------------------------------------------- artefacts
-BEBE = ("BE/BE (plastic work piece by the BEM with Newton potentials, Section 4.2.4, "
-        "Algorithm 4.2) is not implemented in this round: not computed.")
-
-
 def field_artefacts(prm, runs, example, ids, notes, meta) -> list[ArtefactResult]:
     """Deformed mesh and ||eps_p|| artefacts of FE/FE and FE/BE (ids in that order)."""
     th = prm.thetas[0]
@@ -449,29 +635,39 @@ def field_artefacts(prm, runs, example, ids, notes, meta) -> list[ArtefactResult
 
 
 def run(config: dict, quick: bool = False) -> list[ArtefactResult]:
-    """Figures 4.1-4.12 (``quick`` unused: config/quick.yaml sets the sizes)."""
+    """Figures 4.1-4.12 (config/quick.yaml sets the sizes)."""
     prm = from_config(Params, config, scene="ch4_plasticity")
     t0 = time.perf_counter()
     runs = all_runs(prm)
-    failed = [f"{k}: {t.reason}" for k, r in runs.items() for t in r.touches if not t.converged]
+    bebe = bebe_runs(prm)
+    failed = [f"{k}: {t.reason}" for k, r in [*runs.items(), *bebe.items()]
+              for t in r.touches if not t.converged]
     notes = " ".join(CHOICES) + (" FAILED RUNS: " + "; ".join(failed) if failed else "")
     its = [rec.iterations for r in runs.values() for rec in r.records]
     meta = dict(run_s=time.perf_counter() - t0, runs=len(runs), all_converged=not failed,
                 newton_total=int(sum(its)), newton_max_per_increment=int(max(its)),
-                newton_mean_per_increment=float(np.mean(its)))
+                newton_mean_per_increment=float(np.mean(its)),
+                bebe_s=bebe["BE/BE"].wall_s if bebe else None,
+                bebe_newton_per_increment=" ".join(
+                    str(r.iterations) for r in bebe["BE/BE"].records) if bebe else None)
     ex1 = field_artefacts(prm, runs, 1, ARTEFACTS[0:4], notes, meta)
     c1 = curve_table(runs, 1)
     fig5 = ArtefactResult("figure_4_5", c1, curve_figure(prm, runs, 1),
                           claims=[coupling_claim(prm, runs, 1)], notes=notes, meta=meta)
     ex2 = field_artefacts(prm, runs, 2, ARTEFACTS[5:9], notes, meta)
-    empty = pd.DataFrame({"coupling": ["BE/BE"], "computed": [False]})
-    bebe = [ArtefactResult(a, empty, missing_figure(BEBE),
-                           claims=[Claim(c, None, BEBE)], notes=notes, meta=meta)
-            for a, c in (("figure_4_10", "BE/BE deformed mesh qualitatively as FE/FE"),
-                         ("figure_4_11", "BE/BE ||eps_p|| qualitatively as FE/FE"))]
-    c2 = curve_table(runs, 2)
-    fig12 = ArtefactResult("figure_4_12", c2, curve_figure(prm, runs, 2), claims=[
-        coupling_claim(prm, runs, 2),
-        Claim("the BE/BE curve shows qualitatively similar behaviour", None, BEBE),
+    tab = bebe_table(bebe) if bebe else pd.DataFrame({"coupling": ["BE/BE"],
+                                                      "computed": [False]})
+    c_mesh, c_eps = bebe_field_claims(prm, bebe)
+    bb = [ArtefactResult("figure_4_10", tab, bebe_figure(prm, bebe, None,
+                                                         "BE/BE deformed mesh"),
+                         claims=[c_mesh], notes=notes, meta=meta),
+          ArtefactResult("figure_4_11", tab, bebe_figure(prm, bebe, "eps_p_norm",
+                                                         "BE/BE ||eps_p||"),
+                         claims=[c_eps], notes=notes, meta=meta,
+                         exports=bebe_exports(bebe))]
+    c2 = pd.concat([curve_table(runs, 2), bebe_table(bebe)], ignore_index=True) \
+        if bebe else curve_table(runs, 2)
+    fig12 = ArtefactResult("figure_4_12", c2, curve_figure(prm, runs, 2, bebe), claims=[
+        coupling_claim(prm, runs, 2), bebe_curve_claim(prm, runs, bebe),
         mesh_claim(prm, runs)], notes=notes, meta=meta)
-    return ex1 + [fig5] + ex2 + bebe + [fig12]
+    return ex1 + [fig5] + ex2 + bb + [fig12]

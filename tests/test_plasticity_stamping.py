@@ -95,4 +95,7 @@ def test_experiment_quick(tmp_path):
     d5 = json.loads((tmp_path / "figure_4_5.json").read_text())
     assert d5["meta"]["all_converged"] and d5["claims"][0]["holds"] is True
     d10 = json.loads((tmp_path / "figure_4_10.json").read_text())
-    assert d10["claims"][0]["holds"] is None                # BE/BE not computed
+    assert d10["meta"]["all_converged"] and d10["meta"]["bebe_s"] > 0   # BE/BE computed
+    for i in (10, 11, 12):
+        d = json.loads((tmp_path / f"figure_4_{i}.json").read_text())
+        assert all(c["holds"] is not None for c in d["claims"][:2])     # decided

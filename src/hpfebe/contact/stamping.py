@@ -304,3 +304,66 @@ def curve_difference(a, b) -> float:
                          f"{b.shape}")
     peak = float(np.abs(a).max())
     return float(np.abs(a - b).max()) / peak if peak > 0 else float(np.abs(b).max())
+
+
+# --------------------------------------------------------------------------- BE/BE
+def be_work_piece(box, h: float, material: J2Material, cells: str = "crossed"):
+    """The elastoplastic BE work piece (thesis Section 4.2.4) on ``box`` with mesh size h:
+    a degree-1 LameBEM and cells of size h carrying the plastic strain
+    (:func:`hpfebe.plastic_be.rectangle_work_piece`, backward Euler ("implicit")
+    update)."""
+    from ..plastic_be import rectangle_work_piece
+    x0, x1, y0, y1 = box
+    return rectangle_work_piece(box, _cells(x1 - x0, h), _cells(y1 - y0, h), material,
+                                scheme="implicit", cells=cells)
+
+
+def touch_be(stamp, be, u_total: float, n_load: int, X, settings: ContactSettings,
+             touch_id: int = 1) -> TouchResult:
+    """One loading touch (no unloading) of the stamp on the elastoplastic BE work piece
+    ``be`` (:class:`hpfebe.plastic_be.ElastoPlasticBE`, contact body
+    :class:`~hpfebe.plastic_be.PlasticBEBody`): the schedule, predictor and stopping
+    rule of :func:`touch`.  Records: the bottom reaction (S_hat u - G(tau) summed over
+    the bottom y dofs), ||dev sigma|| and ||eps_p|| of the cells touching X.  The
+    snapshot's ``u_work`` is the BE boundary displacement; its ``fields`` the cell fields
+    plus the cell-node displacement ``node_u`` (representation formula)."""
+    from ..plastic_be import PlasticBEBody
+    body = PlasticBEBody(be)
+    E = be.material.E
+    pr = TwoBodyContact(stamp, body, "bottom", "top",
+                        eps_n=1.0 / (settings.eps_n_factor * E),
+                        eps_t=1.0 / (settings.eps_t_factor * E), mu_f=settings.mu_f)
+    top = pr.dofs_on("slave", "top")
+    bx, by = pr.dofs_on("master", "bottom", 0), pr.dofs_on("master", "bottom", 1)
+    fixed = np.concatenate([top, bx, by])
+    is_y = np.concatenate([np.zeros(top.size + bx.size, bool), np.ones(by.size, bool)])
+    by_local = body.dofs_on("bottom", 1)
+    work_y = pr.global_dofs("master", np.arange(1, be.ndofs, 2))
+    width = float(np.ptp(be.bem.mesh.nodes[:, 0]))
+    atol = settings.rtol * be.material.sigma_Y * width
+    out = TouchResult()
+    res, hist, g_prev = None, [], 0.0
+    for k, g in enumerate(lift_schedule(u_total, n_load, 0)):
+        def values(lam, a=g_prev, b=g):
+            return np.where(is_y, a + lam * (b - a), 0.0)
+        new = pr.solve(None, fixed, values, load_factors=[1.0], rtol=settings.rtol,
+                       max_iter=settings.max_iter, max_cuts=settings.max_cuts,
+                       atol=atol, line_search=True, predictor=settings.predictor,
+                       initial=_extrapolated(res, hist, g, work_y))
+        if not new.converged:
+            out.converged = False
+            out.reason = f"touch {touch_id}, increment {k + 1} (g = {g:.3e}): {new.reason}"
+            break
+        res, g_prev = new, g
+        hist.append((g, res.U.copy()))
+        u = res.u_master
+        force = float((be.S @ u - be.plastic_force())[by_local].sum())
+        out.records.append(StepRecord(
+            touch_id, "load", float(g), force, be.value_at("dev_sigma_norm", X),
+            be.value_at("eps_p_norm", X), int(res.info.iterations), len(res.info.steps)))
+    if res is not None:
+        out.u_work = res.u_master.copy()
+        f = {k: v.copy() for k, v in be.fields().items()}
+        f["node_u"] = be.node_displacements(out.u_work)
+        out.peak = Snapshot(touch_id, stamp, res.u_slave.copy(), out.u_work, f, res)
+    return out

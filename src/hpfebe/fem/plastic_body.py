@@ -176,6 +176,13 @@ class ElastoPlasticFE:
         """Indices of the elements whose closure contains ``point`` (one inside an
         element, two on an edge, up to four at a vertex; ValueError if outside)."""
         p = np.asarray(point, dtype=float).reshape(2)
+        # cached per point: skfem's quad element_finder rebuilds a triangle mesh with a
+        # Python-level boundary lookup on every call (measured 11.5 s of a 98 s
+        # stamping run at h = 0.05, two calls per load increment)
+        cache = self.__dict__.setdefault("_elements_at", {})
+        key = (float(p[0]), float(p[1]))
+        if key in cache:
+            return cache[key].copy()
         d = 1e-9 * float(np.ptp(self.mesh.p, axis=1).max())
         off = np.array([[d, d], [d, -d], [-d, d], [-d, -d]])
         x, y = p[0] + off[:, 0], p[1] + off[:, 1]
@@ -186,7 +193,8 @@ class ElastoPlasticFE:
         e = np.unique(e[e >= 0])
         if e.size == 0:
             raise ValueError(f"point must lie in the body, got {tuple(p)!r}")
-        return e
+        cache[key] = e
+        return e.copy()
 
     def value_at(self, key: str, point) -> float:
         """The committed field ``key`` (see :meth:`fields`) at ``point``: its element
