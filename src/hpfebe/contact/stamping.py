@@ -52,7 +52,10 @@ class ContactSettings:
     Coulomb mu_f; Newton tolerance rtol (relative to the force scale), max_iter, at most
     max_cuts halvings per increment; ``predictor``: TwoBodyContact's bonded predictor
     (taken when it lowers the merit; measured: the first increment of the second touch
-    of Example 1 at h = 0.1 needs 33 iterations with it, 98 in 3 attempts without)."""
+    of Example 1 at h = 0.1 needs 33 iterations with it, 98 in 3 attempts without).
+    ``F``: a given (Tresca) friction bound, |t_t| <= F on all of Gamma_C (the penalty
+    law (4.20) with the slip bound F in place of mu_f |p_n|); None = Coulomb with mu_f,
+    a given F replaces mu_f (:meth:`friction`)."""
 
     eps_n_factor: float = 10.0
     eps_t_factor: float = 5.0
@@ -61,6 +64,7 @@ class ContactSettings:
     max_iter: int = 40
     max_cuts: int = 4
     predictor: bool = True
+    F: float | None = None
 
     def __post_init__(self):
         for name in ("eps_n_factor", "eps_t_factor", "rtol"):
@@ -68,9 +72,21 @@ class ContactSettings:
                 raise ValueError(f"{name} must be positive, got {getattr(self, name)!r}")
         if self.mu_f < 0:
             raise ValueError(f"mu_f must be >= 0, got {self.mu_f!r}")
+        if self.F is not None and (isinstance(self.F, bool) or not isinstance(
+                self.F, (int, float, np.integer, np.floating)) or not np.isfinite(self.F)
+                or self.F < 0):
+            raise ValueError(f"F (Tresca bound) must be None or a finite number >= 0, got "
+                             f"{self.F!r}")
         if self.max_iter < 1 or self.max_cuts < 0:
             raise ValueError(f"max_iter must be >= 1 and max_cuts >= 0, got "
                              f"{self.max_iter!r}, {self.max_cuts!r}")
+
+    def friction(self) -> dict:
+        """The friction keywords of :class:`TwoBodyContact`: Coulomb ``mu_f`` (F None)
+        or Tresca ``F`` with mu_f = 0."""
+        if self.F is None:
+            return dict(mu_f=self.mu_f)
+        return dict(mu_f=0.0, F=float(self.F))
 
 
 @dataclass
@@ -158,7 +174,7 @@ def touch(stamp, fe: ElastoPlasticFE, u_total: float, n_load: int, n_unload: int
     E = fe.material.E
     pr = TwoBodyContact(stamp, body, "bottom", "top",
                         eps_n=1.0 / (settings.eps_n_factor * E),
-                        eps_t=1.0 / (settings.eps_t_factor * E), mu_f=settings.mu_f)
+                        eps_t=1.0 / (settings.eps_t_factor * E), **settings.friction())
     top = pr.dofs_on("slave", "top")
     bx, by = pr.dofs_on("master", "bottom", 0), pr.dofs_on("master", "bottom", 1)
     fixed = np.concatenate([top, bx, by])
@@ -332,7 +348,7 @@ def touch_be(stamp, be, u_total: float, n_load: int, X, settings: ContactSetting
     E = be.material.E
     pr = TwoBodyContact(stamp, body, "bottom", "top",
                         eps_n=1.0 / (settings.eps_n_factor * E),
-                        eps_t=1.0 / (settings.eps_t_factor * E), mu_f=settings.mu_f)
+                        eps_t=1.0 / (settings.eps_t_factor * E), **settings.friction())
     top = pr.dofs_on("slave", "top")
     bx, by = pr.dofs_on("master", "bottom", 0), pr.dofs_on("master", "bottom", 1)
     fixed = np.concatenate([top, bx, by])
