@@ -87,6 +87,39 @@ def test_homogeneous_plastic_state_matches_material_point(punch_bodies):
                                atol=1e-6 * np.abs(rm.sigma).max())
 
 
+@pytest.mark.parametrize("theta", [1.0, 0.0])
+def test_implicit_reversed_path_follows_material_point(punch_bodies, theta):
+    """Isotropic (theta = 1) and kinematic (theta = 0) hardening, backward Euler cell
+    strains (scheme "implicit"), u = lam eps_bar x on Gamma along a loading-reversal
+    path: every cell follows the material point (return map), and the two hardening
+    rules part on the reversal (Bauschinger effect)."""
+    _, be = punch_bodies
+    mat = J2Material(MAT.E, MAT.nu, MAT.sigma_Y, MAT.H, theta)
+    be = fresh(be)
+    be.material, be.scheme, be._icache, be._ilast = mat, "implicit", None, None
+    eb = np.array([[2e-3, 1e-3], [1e-3, -1.5e-3]])
+    X = be.bem.mesh.nodes
+    st, other = J2State.zeros(1), J2State.zeros(1)
+    mat_other = J2Material(MAT.E, MAT.nu, MAT.sigma_Y, MAT.H, 1.0 - theta)
+    for lam in (0.5, 1.0, 0.0, -1.0):
+        u = lam * (X @ eb.T).ravel()
+        be.implicit_response(u)
+        assert be.inner_info.converged
+        be.commit(u)
+        rm = return_map(mat, (lam * eb)[None], st, None)
+        st = rm.state
+        ro = return_map(mat_other, (lam * eb)[None], other, None)
+        other = ro.state
+        scale = np.abs(rm.sigma).max()
+        np.testing.assert_allclose(be.sigma, np.broadcast_to(rm.sigma, be.sigma.shape),
+                                   atol=1e-6 * scale)
+        np.testing.assert_allclose(be.committed.beta,
+                                   np.broadcast_to(st.beta, be.committed.beta.shape),
+                                   atol=1e-6 * scale)
+    assert rm.plastic[0]
+    assert np.abs(rm.sigma - ro.sigma).max() > 1e-3 * scale     # the rules differ
+
+
 def punch_fe(fem, depth, lams):
     fe = ElastoPlasticFE(fem, MAT)
     b = fe.elastic

@@ -96,6 +96,8 @@ def test_experiment_quick(tmp_path):
     assert d5["meta"]["all_converged"] and d5["claims"][0]["holds"] is True
     d10 = json.loads((tmp_path / "figure_4_10.json").read_text())
     assert d10["meta"]["all_converged"] and d10["meta"]["bebe_s"] > 0   # BE/BE computed
+    assert set(d10["meta"]["bebe_s_per_theta"]) == {"1", "0"}           # both hardenings
+    assert all("theta=0" in c["evidence"] for c in d10["claims"])
     for i in (10, 11, 12):
         d = json.loads((tmp_path / f"figure_4_{i}.json").read_text())
         assert all(c["holds"] is not None for c in d["claims"][:2])     # decided

@@ -78,6 +78,7 @@ import scipy.linalg as sla
 import scipy.sparse as sp
 
 from .bem.lame import LameBEM
+from .bem.potentials import POT_LAME_DL, evaluate_potential
 from .geometry import BoundaryMesh
 from .contact.bodies import BEBody
 from .fem.newton_potential import (CellComplex, edge_integrals, initial_stress,
@@ -101,7 +102,8 @@ def _times_blocks(A: np.ndarray, D: np.ndarray) -> np.ndarray:
     """A @ blockdiag(D) for A (m, 3 n) and n blocks D (n, 3, 3), without forming the
     block diagonal matrix."""
     m, n = A.shape[0], D.shape[0]
-    return np.einsum("rna,nab->rnb", A.reshape(m, n, 3), D).reshape(m, 3 * n)
+    A = np.ascontiguousarray(A)             # a column selection M[:, p] may be strided
+    return np.matmul(A.reshape(m, n, 1, 3), D[None]).reshape(m, 3 * n)
 
 
 def _graded_rule(levels: int = 4, order: int = 8):
@@ -242,10 +244,11 @@ class ElastoPlasticBE:
         points Y (the initial-strain Somigliana identity, module doc:
         u = V~ Psi(u) - K~ u + w - V~ P <w, .>)."""
         bem = self.bem
-        nV, zW = 2 * bem.V_space.ndof, np.zeros(2 * bem.W_space.ndof)
+        nV = 2 * bem.V_space.ndof
         Y = np.atleast_2d(np.asarray(Y, dtype=float))
         SL = self._single_layer(Y)                                       # (2Y, nW)
-        DL = self._columns(lambda p, e: bem.representation(p, e, zW), nV, Y, 2)
+        DL = -self._columns(lambda p, e: evaluate_potential(POT_LAME_DL, bem.kp, 2, p,
+                                                            bem.V_space, e), nV, Y, 2)
         if getattr(self, "_PB", None) is None:
             self._PB = (self._P(bem.B), self._P(self._boundary_w()))
         Nw, _ = newton_operators(self.cells, Y, self.E, self.nu, gradient=False)
