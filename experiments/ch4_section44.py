@@ -359,9 +359,9 @@ def _panel(fig, ax, p, cells, values, clim, title, fmt):
     ax.set_title(title, fontsize=9)
 
 
-def field_figure(bodies: dict, ranges: pd.DataFrame, r: Run) -> Figure:
-    """Row 1: work piece u_x, u_y, ||dev sigma||; row 2: stamp u_x, u_y and the colorbar
-    ranges beside the published ones."""
+def _displacement_panels(bodies: dict):
+    """The 2 x 3 figure of Figures 4.21/4.22 with u_x, u_y of the work piece (row 1) and
+    the stamp (row 2) drawn in the first two columns."""
     fig = Figure(figsize=(13, 7.5), layout="constrained")
     axes = fig.subplots(2, 3, width_ratios=(2.2, 2.2, 2.2))
     for row, b in enumerate(("work", "stamp")):
@@ -372,6 +372,13 @@ def field_figure(bodies: dict, ranges: pd.DataFrame, r: Run) -> Figure:
             axes[row, c].set_xlim(*LIMITS[b][0])
             axes[row, c].set_ylim(*LIMITS[b][1])
             axes[row, c].set_aspect("equal")
+    return fig, axes
+
+
+def field_figure(bodies: dict, ranges: pd.DataFrame, r: Run) -> Figure:
+    """Row 1: work piece u_x, u_y, ||dev sigma||; row 2: stamp u_x, u_y and the colorbar
+    ranges beside the published ones."""
+    fig, axes = _displacement_panels(bodies)
     p, cells, _ = bodies["work"]
     dev = r.peak.fields["dev_sigma_norm"]
     _panel(fig, axes[0, 2], p, cells, dev, (0.0, dev.max()), "work piece: ||dev sigma||",
@@ -932,16 +939,7 @@ def mortar_ranges(bodies: dict, sol) -> pd.DataFrame:
 def mortar_figure(bodies: dict, ranges: pd.DataFrame, sol, pr, title: str) -> Figure:
     """Row 1: work piece u_x, u_y, ||dev sigma|| with the plastic region outlined; row
     2: stamp u_x, u_y and the colorbar ranges beside the published ones."""
-    fig = Figure(figsize=(13, 7.5), layout="constrained")
-    axes = fig.subplots(2, 3, width_ratios=(2.2, 2.2, 2.2))
-    for row, b in enumerate(("work", "stamp")):
-        p, cells, u = bodies[b]
-        for c in (0, 1):
-            _panel(fig, axes[row, c], p, cells, u[cells, c].mean(axis=1),
-                   (u[:, c].min(), u[:, c].max()), f"{b}: u_{'xy'[c]}", "%.2e")
-            axes[row, c].set_xlim(*LIMITS[b][0])
-            axes[row, c].set_ylim(*LIMITS[b][1])
-            axes[row, c].set_aspect("equal")
+    fig, axes = _displacement_panels(bodies)
     p, cells, _ = bodies["work"]
     f = sol.extra["fields"]
     dev = f["dev_sigma_norm_mean"]

@@ -164,14 +164,10 @@ def lift_schedule(u_total: float, n_load: int, n_unload: int) -> np.ndarray:
     return np.concatenate([up, down])
 
 
-def touch(stamp, fe: ElastoPlasticFE, u_total: float, n_load: int, n_unload: int,
-          X, settings: ContactSettings, offset=None, touch_id: int = 1) -> TouchResult:
-    """One touch (module doc): returns the per-increment records, the snapshot at the
-    peak and the work piece's total displacement at the end (the offset of a next
-    touch).  A failed increment (after ``max_cuts`` cuts) ends the touch with its reason;
-    the committed history is that of the last converged increment."""
-    body = PlasticFEBody(fe, offset)
-    E = fe.material.E
+def _stamp_on_work(stamp, body, E: float, settings: ContactSettings):
+    """The penalty contact of the stamp's bottom (slave) on the work piece's top
+    (master), 1/eps = factor x E, and the dofs a touch prescribes: the stamp's top and
+    the work piece's bottom (``is_y`` marks the lifted y components)."""
     pr = TwoBodyContact(stamp, body, "bottom", "top",
                         eps_n=1.0 / (settings.eps_n_factor * E),
                         eps_t=1.0 / (settings.eps_t_factor * E), **settings.friction())
@@ -179,6 +175,17 @@ def touch(stamp, fe: ElastoPlasticFE, u_total: float, n_load: int, n_unload: int
     bx, by = pr.dofs_on("master", "bottom", 0), pr.dofs_on("master", "bottom", 1)
     fixed = np.concatenate([top, bx, by])
     is_y = np.concatenate([np.zeros(top.size + bx.size, bool), np.ones(by.size, bool)])
+    return pr, fixed, is_y
+
+
+def touch(stamp, fe: ElastoPlasticFE, u_total: float, n_load: int, n_unload: int,
+          X, settings: ContactSettings, offset=None, touch_id: int = 1) -> TouchResult:
+    """One touch (module doc): returns the per-increment records, the snapshot at the
+    peak and the work piece's total displacement at the end (the offset of a next
+    touch).  A failed increment (after ``max_cuts`` cuts) ends the touch with its reason;
+    the committed history is that of the last converged increment."""
+    body = PlasticFEBody(fe, offset)
+    pr, fixed, is_y = _stamp_on_work(stamp, body, fe.material.E, settings)
     bottom_y = fe.elastic.dofs_on("bottom", 1)
     work_y = pr.global_dofs("master", fe.elastic.nodal_dofs[1])
     # absolute floor of the stopping test: rtol x sigma_Y x width, the force scale of
@@ -345,14 +352,7 @@ def touch_be(stamp, be, u_total: float, n_load: int, X, settings: ContactSetting
     plus the cell-node displacement ``node_u`` (representation formula)."""
     from ..plastic_be import PlasticBEBody
     body = PlasticBEBody(be)
-    E = be.material.E
-    pr = TwoBodyContact(stamp, body, "bottom", "top",
-                        eps_n=1.0 / (settings.eps_n_factor * E),
-                        eps_t=1.0 / (settings.eps_t_factor * E), **settings.friction())
-    top = pr.dofs_on("slave", "top")
-    bx, by = pr.dofs_on("master", "bottom", 0), pr.dofs_on("master", "bottom", 1)
-    fixed = np.concatenate([top, bx, by])
-    is_y = np.concatenate([np.zeros(top.size + bx.size, bool), np.ones(by.size, bool)])
+    pr, fixed, is_y = _stamp_on_work(stamp, body, be.material.E, settings)
     by_local = body.dofs_on("bottom", 1)
     work_y = pr.global_dofs("master", np.arange(1, be.ndofs, 2))
     width = float(np.ptp(be.bem.mesh.nodes[:, 0]))
