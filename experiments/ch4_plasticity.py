@@ -103,6 +103,15 @@ CHOICES = (
     "h = 0.2, 0.1, 0.05), and the BE/BE h = 0.2 curve lies within 1.5 % of FE/FE h = 0.1 "
     "and 6.3 % of h = 0.05; its top surface agrees except at the two outer corners "
     "(u_y 4.27e-3 vs 3.51e-3, 21.6 %).",
+    "BE/BE mesh study (beyond the thesis, figure_4_12): BE/BE and FE/FE on the same "
+    "meshes bebe_h_levels (default 1.0, 0.5, 0.4; the bebe_h run is reused), theta = "
+    "thetas[0]; successive differences of the ||dev sigma|| curve at X, of the force "
+    "curve and of the plastic zone area (cells / elements with ||eps_p|| > zone_tol at "
+    "full lift), and the same per halving of h (divided by log2(h_i / h_i+1), as "
+    "0.5 -> 0.4 is a smaller step than 1.0 -> 0.5; shrinking raw differences there would "
+    "hold for almost any sequence). h = 0.25 (512 cells) is not in the study: measured "
+    "104 s for theta = 1 at load 2 (one BLAS thread), ||dev sigma||_X 6.66 and force "
+    "22.00 at full lift against 4.74 and 24.76 at h = 0.4.",
 )
 
 
@@ -135,6 +144,7 @@ class Params:
     bebe: bool = True                # BE/BE of Example 2 (figures 4.10, 4.11, 4.12)
     bebe_h: float = 0.4              # its mesh and cell size
     bebe_cells: str = "crossed"
+    bebe_h_levels: tuple[float, ...] = (1.0, 0.5, 0.4)   # BE/BE mesh study, thetas[0]
 
     def __post_init__(self):
         if not self.thetas or any(not 0 <= t <= 1 for t in self.thetas):
@@ -148,6 +158,9 @@ class Params:
                      "bebe_h"):
             if not getattr(self, name) > 0:
                 raise ValueError(f"{name} must be positive, got {getattr(self, name)!r}")
+        hs = self.bebe_h_levels
+        if any(not h > 0 for h in hs) or any(b >= a for a, b in zip(hs, hs[1:])):
+            raise ValueError(f"bebe_h_levels must be positive and decreasing, got {hs!r}")
 
     @property
     def settings(self) -> ContactSettings:
@@ -212,20 +225,32 @@ def bebe_runs(prm: Params, runs: dict | None = None) -> dict:
     ``runs`` when bebe_h is one of h_levels): {theta: {"BE/BE": Run, "FE/FE": Run}}."""
     if not prm.bebe:
         return {}
-    out = {}
-    for th in prm.thetas:
-        h = prm.bebe_h
-        t0 = time.perf_counter()
-        mat = J2Material(prm.E, prm.nu, prm.sigma_Y, prm.H, th)
-        be = be_work_piece(WORK, h, mat, prm.bebe_cells)
-        body = stamp_body("BE", STAMPS[2][0], h, prm.E, prm.nu, p=1)
-        tr = touch_be(body, be, prm.ex2_u, prm.n_load, POINT[2], prm.settings)
-        if not tr.converged:
-            log.warning("BE/BE theta=%g h=%g: %s", th, h, tr.reason)
-        bb = Run(2, "BE/BE", th, h, prm.bebe_cells, be, [tr], time.perf_counter() - t0)
-        fefe = (runs or {}).get((2, "FE", th, h, "bbar")) or run_example(prm, 2, "FE", th, h)
-        out[th] = {"BE/BE": bb, "FE/FE": fefe}
-    return out
+    return {th: _bebe_pair(prm, th, prm.bebe_h, runs) for th in prm.thetas}
+
+
+def _bebe_pair(prm: Params, th: float, h: float, runs: dict | None) -> dict:
+    """BE/BE of Example 2 on mesh h and FE/FE on the same mesh (from ``runs`` if there)."""
+    t0 = time.perf_counter()
+    mat = J2Material(prm.E, prm.nu, prm.sigma_Y, prm.H, th)
+    be = be_work_piece(WORK, h, mat, prm.bebe_cells)
+    body = stamp_body("BE", STAMPS[2][0], h, prm.E, prm.nu, p=1)
+    tr = touch_be(body, be, prm.ex2_u, prm.n_load, POINT[2], prm.settings)
+    if not tr.converged:
+        log.warning("BE/BE theta=%g h=%g: %s", th, h, tr.reason)
+    bb = Run(2, "BE/BE", th, h, prm.bebe_cells, be, [tr], time.perf_counter() - t0)
+    fefe = (runs or {}).get((2, "FE", th, h, "bbar")) or run_example(prm, 2, "FE", th, h)
+    return {"BE/BE": bb, "FE/FE": fefe}
+
+
+def bebe_mesh_study(prm: Params, runs: dict, bebe: dict) -> dict:
+    """Beyond the thesis: BE/BE (and FE/FE on the same meshes) of Example 2 on every mesh
+    of bebe_h_levels, theta = thetas[0]; the bebe_h run of :func:`bebe_runs` is reused:
+    {h: {"BE/BE": Run, "FE/FE": Run}} ({} when bebe is off or fewer than two levels)."""
+    th, hs = prm.thetas[0], prm.bebe_h_levels
+    if not prm.bebe or len(hs) < 2:
+        return {}
+    return {h: bebe[th] if h == prm.bebe_h and th in bebe else _bebe_pair(prm, th, h, runs)
+            for h in progress(hs, desc="BE/BE mesh study")}
 
 
 def curve_table(runs: dict, example: int) -> pd.DataFrame:
@@ -395,6 +420,83 @@ def bebe_curve_claim(prm: Params, runs: dict, bebe: dict) -> Claim:
                  "; ".join(ev))
 
 
+def _plastic_area(run: Run, zone_tol: float) -> float:
+    """Area of the plastic zone at the peak of the first touch: BE/BE cells or FE
+    elements with (mean) ||eps_p|| > zone_tol."""
+    eps = run.touches[0].peak.fields["eps_p_norm"]
+    areas = run.fe.cells.areas if run.stamp == "BE/BE" else element_areas(run.fe)
+    return float(areas[eps > zone_tol].sum())
+
+
+def _successive(prm: Params, study: dict, name: str) -> dict:
+    """Successive differences of one discretisation over the meshes of ``study``: max
+    relative difference of the ||dev sigma|| and force curves (relative to the finer
+    mesh's peak), relative difference of the plastic zone area, and the same divided by
+    log2(h_i / h_i+1) (per halving of h: the meshes are not refined by a constant ratio;
+    a sequence converging at any positive order has shrinking scaled differences)."""
+    hs, rs = list(study), [study[h][name] for h in study]
+    area = [_plastic_area(r, prm.zone_tol) for r in rs]
+    d = {"dev": [curve_difference(_load_curve(rs[i + 1]), _load_curve(rs[i]))
+                 for i in range(len(hs) - 1)],
+         "force": [curve_difference(_load_curve(rs[i + 1], "force"),
+                                    _load_curve(rs[i], "force")) for i in range(len(hs) - 1)],
+         "zone": [abs(area[i + 1] - area[i]) / max(area[i + 1], 1e-300)
+                  for i in range(len(hs) - 1)]}
+    per = [np.log2(hs[i] / hs[i + 1]) for i in range(len(hs) - 1)]
+    return dict(raw=d, scaled={k: [v / q for v, q in zip(x, per)] for k, x in d.items()},
+                area=area, peak_dev=[float(_load_curve(r)[-1]) for r in rs],
+                peak_force=[float(_load_curve(r, "force")[-1]) for r in rs])
+
+
+def _shrinks(x: list) -> bool:
+    return all(b < a or b == 0 for a, b in zip(x, x[1:]))
+
+
+def bebe_mesh_claim(prm: Params, runs: dict, study: dict) -> Claim:
+    """Beyond the thesis: BE/BE under mesh refinement (bebe_h_levels, thetas[0]): the
+    successive differences (per halving of h) of the ||dev sigma|| curve at X, of the
+    applied force and of the plastic zone area shrink; beside them FE/FE on the same
+    meshes, FE/FE on h_levels and BE/BE vs FE/FE on each mesh (``study`` from
+    :func:`bebe_mesh_study`)."""
+    hs = list(study) or list(prm.bebe_h_levels)
+    text = ("(beyond the thesis) BE/BE converges under mesh refinement, h = "
+            + ", ".join(f"{h:g}" for h in hs) + f", theta = {prm.thetas[0]:g}: the "
+            "successive differences of ||dev sigma|| at X along the load path, of the "
+            "applied force and of the plastic zone area, per halving of h (difference / "
+            "log2(h_i / h_i+1)), shrink")
+    if not study:
+        return Claim(text, None, "BE/BE mesh study not run (bebe = false or fewer than "
+                                 "two bebe_h_levels)")
+    bad = [f"{k} h={h:g}: {r.touches[-1].reason}" for h, p in study.items()
+           for k, r in p.items() if not r.converged or r.touches[0].peak is None]
+    if bad:
+        return Claim(text, False, "did not converge: " + "; ".join(bad))
+    bb, ff = _successive(prm, study, "BE/BE"), _successive(prm, study, "FE/FE")
+    pct = lambda x: ", ".join(f"{v:.2%}" for v in x)            # noqa: E731
+    num = lambda x: ", ".join(f"{v:.4g}" for v in x)            # noqa: E731
+    ev = []
+    for name, r in (("BE/BE", bb), ("FE/FE same meshes", ff)):
+        ev.append(f"{name}: successive differences (raw / per halving) ||dev sigma|| at X "
+                  f"{pct(r['raw']['dev'])} / {pct(r['scaled']['dev'])}, force "
+                  f"{pct(r['raw']['force'])} / {pct(r['scaled']['force'])}, plastic zone "
+                  f"area {pct(r['raw']['zone'])} / {pct(r['scaled']['zone'])}; at full "
+                  f"lift ||dev sigma||_X {num(r['peak_dev'])}, force "
+                  f"{num(r['peak_force'])}, zone area {num(r['area'])}")
+    same = [(curve_difference(_load_curve(p["FE/FE"]), _load_curve(p["BE/BE"])),
+             curve_difference(_load_curve(p["FE/FE"], "force"),
+                              _load_curve(p["BE/BE"], "force"))) for p in study.values()]
+    ev.append("BE/BE vs FE/FE on the same mesh (||dev sigma|| / force): " + ", ".join(
+        f"h={h:g}: {a:.2%} / {b:.2%}" for h, (a, b) in zip(hs, same)))
+    th, fh = prm.thetas[0], prm.h_levels
+    fe = [_curve(runs[(2, "FE", th, h, "bbar")]) for h in fh]
+    ev.append("FE/FE on h_levels " + ", ".join(f"{h:g}" for h in fh) + ": successive "
+              "||dev sigma|| differences " + pct(
+                  [curve_difference(fe[i + 1], fe[i]) for i in range(len(fh) - 1)]))
+    holds = None if len(hs) < 3 else bool(all(_shrinks(bb["scaled"][k])
+                                              for k in ("dev", "force", "zone")))
+    return Claim(text, holds, "; ".join(ev))
+
+
 def _bebe_vs_fe(bebe: dict):
     """BE/BE fields and top displacement against FE/FE on the same grid at the peak:
     (FE element areas, BE ||eps_p|| averaged over the cells in each FE element (area
@@ -562,7 +664,10 @@ def bebe_figure(prm: Params, bebe: dict, field: str | None, title: str) -> Figur
     return fig
 
 
-def curve_figure(prm: Params, runs: dict, example: int, bebe: dict | None = None) -> Figure:
+def curve_figure(prm: Params, runs: dict, example: int, bebe: dict | None = None,
+                 study: dict | None = None) -> Figure:
+    """||dev sigma|| at X against the applied force: FE/FE, FE/BE (and BE/BE) per theta;
+    last panel: the FE/FE mesh study (B-bar, full Q1) and the BE/BE mesh study."""
     th0 = prm.thetas
     ncol = len(th0) + 1
     fig = Figure(figsize=(4.8 * ncol, 4.2))
@@ -601,6 +706,11 @@ def curve_figure(prm: Params, runs: dict, example: int, bebe: dict | None = None
             ax.plot([f0] + [x.force for x in load], [s0] + [x.dev_sigma_X for x in load],
                     style, color=f"C{i}",
                     label=f"FE/FE {'B-bar' if form == 'bbar' else 'full Q1'} h={h:g}")
+    for i, (h, pair) in enumerate((study or {}).items()):
+        r = pair["BE/BE"]
+        if r.records:
+            ax.plot([0.0, *_load_curve(r, "force")], [0.0, *_load_curve(r)], "-.^", ms=2,
+                    color=f"C{len(prm.h_levels) + i}", label=f"BE/BE h={h:g}")
     ax.set_title(f"mesh study, theta = {th0[0]:g}, touch {last}", fontsize=9)
     ax.set_xlabel("applied force")
     ax.legend(fontsize=6)
@@ -667,8 +777,13 @@ def run(config: dict, quick: bool = False) -> list[ArtefactResult]:
     t0 = time.perf_counter()
     runs = all_runs(prm)
     bebe = bebe_runs(prm, runs)
+    t_study = time.perf_counter()
+    study = bebe_mesh_study(prm, runs, bebe)
+    t_study = time.perf_counter() - t_study
     bb_runs = [(f"BE/BE theta={th:g}", pair["BE/BE"]) for th, pair in bebe.items()]
-    failed = [f"{k}: {t.reason}" for k, r in [*runs.items(), *bb_runs]
+    st_runs = [(f"BE/BE study h={h:g}", p["BE/BE"]) for h, p in study.items()
+               if h != prm.bebe_h]
+    failed = [f"{k}: {t.reason}" for k, r in [*runs.items(), *bb_runs, *st_runs]
               for t in r.touches if not t.converged]
     notes = " ".join(CHOICES) + (" FAILED RUNS: " + "; ".join(failed) if failed else "")
     its = [rec.iterations for r in runs.values() for rec in r.records]
@@ -680,6 +795,11 @@ def run(config: dict, quick: bool = False) -> list[ArtefactResult]:
                 bebe_newton_per_increment="; ".join(
                     f"theta={r.theta:g}: " + " ".join(str(x.iterations) for x in r.records)
                     for _, r in bb_runs) if bebe else None)
+    meta12 = dict(meta, bebe_study_s=t_study if study else None,
+                  bebe_study_s_per_h={f"{h:g}": p["BE/BE"].wall_s for h, p in study.items()},
+                  bebe_study_newton_per_increment="; ".join(
+                      f"h={h:g}: " + " ".join(str(x.iterations) for x in p["BE/BE"].records)
+                      for h, p in study.items()) if study else None)
     ex1 = field_artefacts(prm, runs, 1, ARTEFACTS[0:4], notes, meta)
     c1 = curve_table(runs, 1)
     fig5 = ArtefactResult("figure_4_5", c1, curve_figure(prm, runs, 1),
@@ -698,7 +818,11 @@ def run(config: dict, quick: bool = False) -> list[ArtefactResult]:
                          exports=bebe_exports(bebe))]
     c2 = pd.concat([curve_table(runs, 2), bebe_table(bebe)]).drop_duplicates(
         ignore_index=True) if bebe else curve_table(runs, 2)     # FE/FE bebe_h may be in both
-    fig12 = ArtefactResult("figure_4_12", c2, curve_figure(prm, runs, 2, bebe), claims=[
-        coupling_claim(prm, runs, 2), bebe_curve_claim(prm, runs, bebe),
-        mesh_claim(prm, runs)], notes=notes, meta=meta)
+    c2 = pd.concat([c2, bebe_table(study)]).drop_duplicates(ignore_index=True) \
+        if study else c2                                  # BE/BE mesh study: new meshes only
+    fig12 = ArtefactResult("figure_4_12", c2, curve_figure(prm, runs, 2, bebe, study),
+                           claims=[coupling_claim(prm, runs, 2),
+                                   bebe_curve_claim(prm, runs, bebe), mesh_claim(prm, runs),
+                                   bebe_mesh_claim(prm, runs, study)],
+                           notes=notes, meta=meta12)
     return ex1 + [fig5] + ex2 + bb + [fig12]

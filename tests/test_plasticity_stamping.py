@@ -101,3 +101,9 @@ def test_experiment_quick(tmp_path):
     for i in (10, 11, 12):
         d = json.loads((tmp_path / f"figure_4_{i}.json").read_text())
         assert all(c["holds"] is not None for c in d["claims"][:2])     # decided
+    # BE/BE mesh study (bebe_h_levels, three meshes, thetas[0]): present and decided
+    d12 = json.loads((tmp_path / "figure_4_12.json").read_text())
+    assert len(d12["meta"]["bebe_study_s_per_h"]) == 3
+    study = [c for c in d12["claims"] if "BE/BE converges under mesh refinement" in c["text"]]
+    assert len(study) == 1 and study[0]["holds"] is not None
+    assert "BE/BE vs FE/FE on the same mesh" in study[0]["evidence"]
