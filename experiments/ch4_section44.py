@@ -334,18 +334,24 @@ def body_fields(prm: Params, r: Run) -> dict:
             "stamp": (ps, np.asarray(cs), us)}
 
 
-def colour_ranges(bodies: dict, r: Run) -> pd.DataFrame:
+def _ranges(bodies: dict, dev: np.ndarray, pub_ux: dict, pub_uy: dict,
+            pub_dev_max: float) -> pd.DataFrame:
+    """Our colorbar ranges (nodal u_x, u_y of both bodies, ||dev sigma_m||) beside the
+    published ones of Figure 4.21 or 4.22."""
     rows = []
     for b, (_, _, u) in bodies.items():
-        for c, name, pub in ((0, "u_x", PUB_UX), (1, "u_y", PUB_UY)):
+        for c, name, pub in ((0, "u_x", pub_ux), (1, "u_y", pub_uy)):
             rows.append(dict(body=b, field=name, ours_min=float(u[:, c].min()),
                              ours_max=float(u[:, c].max()), published_min=pub[b][0],
                              published_max=pub[b][1]))
-    dev = r.peak.fields["dev_sigma_norm"]
     rows.append(dict(body="work", field="dev_sigma_norm", ours_min=float(dev.min()),
                      ours_max=float(dev.max()), published_min=float("nan"),
-                     published_max=PUB_DEV_MAX))
+                     published_max=pub_dev_max))
     return pd.DataFrame(rows)
+
+
+def colour_ranges(bodies: dict, r: Run) -> pd.DataFrame:
+    return _ranges(bodies, r.peak.fields["dev_sigma_norm"], PUB_UX, PUB_UY, PUB_DEV_MAX)
 
 
 LIMITS = {"work": ((-2.1, 2.1), (-2.1, 0.1)), "stamp": ((-0.6, 0.6), (-0.1, 2.1))}
@@ -922,18 +928,8 @@ def comparison_table(prm: Params, pr, sol, free, runs: dict) -> tuple[pd.DataFra
 
 
 def mortar_ranges(bodies: dict, sol) -> pd.DataFrame:
-    rows = []
-    for b, (_, _, u) in bodies.items():
-        for c, name, pub in ((0, "u_x", PUB_MORTAR_UX), (1, "u_y", PUB_MORTAR_UY)):
-            rows.append(dict(body=b, field=name, ours_min=float(u[:, c].min()),
-                             ours_max=float(u[:, c].max()), published_min=pub[b][0],
-                             published_max=pub[b][1]))
-    f = sol.extra["fields"]
-    rows.append(dict(body="work", field="dev_sigma_norm",
-                     ours_min=float(f["dev_sigma_norm_mean"].min()),
-                     ours_max=float(f["dev_sigma_norm_mean"].max()),
-                     published_min=float("nan"), published_max=PUB_MORTAR_DEV_MAX))
-    return pd.DataFrame(rows)
+    return _ranges(bodies, sol.extra["fields"]["dev_sigma_norm_mean"], PUB_MORTAR_UX,
+                   PUB_MORTAR_UY, PUB_MORTAR_DEV_MAX)
 
 
 def mortar_figure(bodies: dict, ranges: pd.DataFrame, sol, pr, title: str) -> Figure:

@@ -122,7 +122,8 @@ def _compare_numeric(col: str, a: np.ndarray, b: np.ndarray, rtol: float,
 
 
 def _compare_text(col: str, a: pd.Series, b: pd.Series) -> list[str]:
-    sa, sb = a.astype(str).to_numpy(), b.astype(str).to_numpy()
+    # missing values compare equal (pandas' string dtype keeps NaN through astype(str))
+    sa, sb = (s.astype(str).fillna("<NA>").to_numpy(dtype=object) for s in (a, b))
     bad = np.flatnonzero(sa != sb)
     if not bad.size:
         return []
