@@ -64,6 +64,28 @@ def artefact_outputs(artefacts):
 
 ALL_RESULTS = [p for e in REGISTRY for p in artefact_outputs(e.artefacts)]
 
+# The numba kernels are compiled once, by the first job (`hpfebe compile`), and loaded
+# from numba's on-disk cache by every module that calls them (experiments/registry.py:
+# a module with NUMBA = False runs beside that job).  Without it the first two jobs of a
+# fresh machine compile the same kernels at once.  Only modules whose results are missing
+# wait for the stamp (a pure ordering: the stamp never makes a built module rerun).
+NUMBA_STAMP = f"{LOGS}/numba_cache.json"
+
+
+def waits_for_numba(exp):
+    return exp.numba and not all(Path(p).exists() for p in artefact_outputs(exp.artefacts))
+
+
+# Longest modules first (two jobs on two cores: the run ends when its longest module
+# does; the report's Timing table has the measured times).  Others get priority 0.
+LONGEST_FIRST = ["ch4_plasticity", "ch4_section44", "ch2_convergence", "ch4_adaptive_fefe",
+                 "ch4_mortar", "ch3_penalty_hp", "ch3_adaptive_bem"]
+
+
+def priority_of(name):
+    return len(LONGEST_FIRST) - LONGEST_FIRST.index(name) if name in LONGEST_FIRST else 0
+
+
 localrules: all, report
 
 
@@ -80,11 +102,13 @@ for _exp in REGISTRY:
         input:
             module=str(_exp.path.relative_to(workflow.basedir)),
             config=CONFIG_FILES,
+            numba=[ancient(NUMBA_STAMP)] if waits_for_numba(_exp) else [],
         output:
             artefact_outputs(_exp.artefacts),
         log:
             f"{LOGS}/{_exp.name}.log",
         threads: 1
+        priority: priority_of(_exp.name)
         params:
             artefact=_exp.artefacts[0],
             flags=" ".join((["--quick"] if QUICK else [])
@@ -92,6 +116,17 @@ for _exp in REGISTRY:
         shell:
             f"{WATCH_ENV} {THREAD_ENV} {PYTHON} -m hpfebe run {{params.artefact}} --out {RESULTS} "
             "{params.flags} 2> {log}"
+
+
+rule numba_cache:
+    output:
+        NUMBA_STAMP,
+    log:
+        f"{LOGS}/numba_cache.log",
+    threads: 1
+    priority: 100
+    shell:
+        f"{WATCH_ENV} {THREAD_ENV} {PYTHON} -m hpfebe compile --stamp {{output}} 2> {{log}}"
 
 
 rule report:

@@ -51,6 +51,7 @@ from hpfebe.params import FrictionalContactScene, from_config
 from hpfebe.results import ArtefactResult, Claim, beats_uniform_claim, progress
 
 ARTEFACTS = ("figure_4_13", "figure_4_14", "figure_4_15", "figure_4_16")
+NUMBA = False    # FE/FE only: runs beside the job that compiles the numba kernels
 
 log = logging.getLogger(__name__)
 

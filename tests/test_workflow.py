@@ -59,6 +59,26 @@ def test_one_rule_per_module():
     assert {e.name for e in reg} <= rules
 
 
+def test_numba_kernels_compiled_once_first(tmp_path):
+    """On a fresh machine (no results yet) one `hpfebe compile` job comes first and every
+    module calling numba waits for it (no two jobs compile the same kernels); a module
+    with NUMBA = False runs beside it.  (Modules whose results exist never wait: the
+    stamp only orders jobs.)"""
+    reg = _registry_module().discover(ROOT / "experiments")
+    for d in ("experiments", "config", "report", "src", "profiles"):
+        (tmp_path / d).symlink_to(ROOT / d)
+    r = subprocess.run([sys.executable, "-m", "snakemake", "-n", "-s", str(ROOT / "Snakefile"),
+                        "--configfile", "config/quick.yaml"], cwd=tmp_path,
+                       capture_output=True, text=True, timeout=600)
+    assert r.returncode == 0, r.stdout + r.stderr
+    blocks = {b.split(":", 1)[0].strip(): b for b in r.stdout.split("\nrule ")[1:]}
+    assert "numba_cache" in blocks
+    for e in reg:
+        waits = "results/logs/numba_cache.json" in blocks[e.name].split("output:")[0]
+        assert waits == e.numba, e.name
+    assert any(not e.numba for e in reg)
+
+
 def test_slurm_profile_dry_run():
     pytest.importorskip("snakemake_executor_plugin_slurm",
                         reason="snakemake-executor-plugin-slurm not installed "
@@ -90,6 +110,11 @@ def test_registry_rules(tmp_path):
         registry.discover(tmp_path)
     (tmp_path / "ch1_b.py").write_text('ARTEFACTS = tuple(f"t{i}" for i in range(2))\n')
     with pytest.raises(ValueError, match="literal"):
+        registry.discover(tmp_path)
+    (tmp_path / "ch1_b.py").write_text('ARTEFACTS = ("table_1_2",)\nNUMBA = False\n')
+    assert [e.numba for e in registry.discover(tmp_path)] == [True, False]
+    (tmp_path / "ch1_b.py").write_text('ARTEFACTS = ("table_1_2",)\nNUMBA = "no"\n')
+    with pytest.raises(ValueError, match="NUMBA must be"):
         registry.discover(tmp_path)
     (tmp_path / "ch1_b.py").unlink()
     (tmp_path / "report.py").write_text('ARTEFACTS = ("table_2_9",)\n')

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import argparse
 import importlib
+import json
 import logging
 import os
 import re
@@ -482,6 +483,25 @@ def cmd_report(args) -> int:
     return EXIT_OK
 
 
+def cmd_compile(args) -> int:
+    """Compile (or load from numba's cache) every numba kernel once; with --stamp FILE,
+    record the times in FILE (JSON, written atomically: the workflow's numba_cache rule)."""
+    from .results import atomic_write
+    from .warmup import compile_kernels
+
+    with JitTimer() as jit:
+        t0 = time.perf_counter()
+        steps = compile_kernels()
+        wall = time.perf_counter() - t0
+    log.info("numba kernels ready in %.1f s (compiling %.1f s): %s", wall, jit.compile_s,
+             ", ".join(f"{k} {v:.2f} s" for k, v in steps.items()))
+    if args.stamp:
+        record = dict(wall_s=round(wall, 3), steps_s={k: round(v, 3) for k, v in steps.items()},
+                      **jit.as_dict())
+        atomic_write(Path(args.stamp), lambda f: json.dump(record, f, indent=1))
+    return EXIT_OK
+
+
 # --------------------------------------------------------------------------- main
 def build_parser() -> argparse.ArgumentParser:
     from . import __version__
@@ -518,6 +538,11 @@ def build_parser() -> argparse.ArgumentParser:
     sp.add_argument("--published", metavar="DIR",
                     help="published tables (default: report/published/)")
     sp.set_defaults(func=cmd_report)
+
+    sp = sub.add_parser("compile", help="compile the numba kernels once (a fresh machine's "
+                                        "first run; later runs load them from the cache)")
+    sp.add_argument("--stamp", metavar="FILE", help="write the times to FILE (JSON)")
+    sp.set_defaults(func=cmd_compile)
     return p
 
 

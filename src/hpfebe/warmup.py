@@ -1,0 +1,70 @@
+"""Compile the numba kernels once, before the experiments need them (``hpfebe compile``).
+
+numba compiles a kernel at its first call and keeps the machine code in its on-disk cache
+(``__pycache__`` beside the sources, or ``NUMBA_CACHE_DIR``).  On a fresh machine the
+experiments of a ``snakemake -j2`` run would each compile the same kernels at once (two
+jobs, the same ~30 s twice); the workflow's ``numba_cache`` rule runs :func:`compile_kernels`
+first instead, and only the modules that call numba wait for it.
+
+The scenes are tiny and go through the public API, so they compile exactly the
+specialisations (argument types) that the experiments use: the BEM assembly of the
+Laplace and Lame operators, the potentials at interior points, the gradient of the single
+layer on Gamma (the residual estimator), boundary-curve checks, and Polyak's projected CG.
+"""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+
+__all__ = ["compile_kernels"]
+
+
+def _bem(steps: dict) -> None:
+    from .bem import LameBEM, LaplaceBEM
+    from .geometry import BoundaryMesh
+
+    t = time.perf_counter()
+    mesh = BoundaryMesh.polygon([(0, 0), (1, 0), (1, 1), (0, 1)], n=2, p=1)
+    steps["geometry"] = time.perf_counter() - t
+
+    t = time.perf_counter()
+    lap = LaplaceBEM(mesh)
+    lap.V, lap.K, lap.W
+    U = np.ones(lap.V_space.ndof)
+    lap.representation([[0.5, 0.5]], U, lap.Psi(U))
+    steps["laplace"] = time.perf_counter() - t
+
+    t = time.perf_counter()
+    lame = LameBEM(mesh, 1.0, 0.3)
+    lame.S_hat
+    U = np.ones(2 * lame.V_space.ndof)
+    psi = lame.Psi(U)
+    lame.representation([[0.5, 0.5]], U, psi)
+    lame.stress([[0.5, 0.5]], U, psi)
+    steps["lame"] = time.perf_counter() - t
+
+    from .adaptivity._ongamma import grad_single_layer_on_gamma
+
+    t = time.perf_counter()
+    grad_single_layer_on_gamma(lap.W_space, np.ones(lap.W_space.ndof), [0], [0.0])
+    steps["estimator"] = time.perf_counter() - t
+
+
+def _contact(steps: dict) -> None:
+    from .contact.mortar import projected_cg
+
+    t = time.perf_counter()
+    A = np.array([[2.0, -1.0], [-1.0, 2.0]])
+    projected_cg(A, np.array([1.0, 1.0]), np.array([0.1, np.inf]))
+    steps["projected_cg"] = time.perf_counter() - t
+
+
+def compile_kernels() -> dict[str, float]:
+    """Run the tiny scenes; returns the wall time [s] of each (compile time on a cold
+    cache, loading time on a warm one)."""
+    steps: dict[str, float] = {}
+    _bem(steps)
+    _contact(steps)
+    return steps
