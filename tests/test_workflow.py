@@ -189,6 +189,23 @@ def test_report_builds_side_by_side(fake_results):
     assert "](../results/figure_9_9.png)" in md
 
 
+def test_report_timing_has_compile_job(fake_results):
+    """The Timing table: one row per module, the workflow's `hpfebe compile` job (its
+    record in results/logs) as a row of its own, and the sums."""
+    res, pub, out = fake_results
+    (res / "logs").mkdir()
+    (res / "logs" / "numba_cache.json").write_text(
+        '{"wall_s": 31.5, "jit_compile_s": 30.25, "jit_s": 30.5, "steps_s": {}}')
+    build_report(res, out, pub, expected={"table_9_9": "ch9", "figure_9_9": "ch9"})
+    for text in ((out / "report.md").read_text(), (out / "index.html").read_text()):
+        timing = text[text.index("Timing"):]
+        assert "numba kernels" in timing and "31.5" in timing
+        assert "33.5" in timing           # 31.5 + the module's run_s 2.0
+    (res / "logs" / "numba_cache.json").write_text("{broken")   # ignored, no crash
+    build_report(res, out, pub, expected={"table_9_9": "ch9", "figure_9_9": "ch9"})
+    assert "numba kernels" not in (out / "report.md").read_text()
+
+
 def test_compare_cells():
     pub = pd.read_csv(pd.io.common.StringIO(PUBLISHED), comment="#")
     rep = pd.DataFrame({"series": ["h", "h"], "h_inv": [3.0, 6.0], "p": [1, 1],
