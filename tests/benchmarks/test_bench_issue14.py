@@ -136,19 +136,20 @@ def test_two_thread_balance(benchmark, N, monkeypatch):
     old = numba.get_num_threads()
     numba.set_num_threads(1)
     calls = []
-    orig = assembly._assemble_rows
+    orig = assembly._assemble_rows            # the parfor that 2 threads run
+    serial = assembly._assemble_rows_serial   # what one thread runs (the same arguments)
 
     def capture(*args):
         calls.append(args)
-        return orig(*args)
+        return serial(*args)
 
     try:
-        monkeypatch.setattr(assembly, "_assemble_rows", capture)
+        monkeypatch.setattr(assembly, "_assemble_rows_serial", capture)
         _vkw(_square(N))
-        monkeypatch.setattr(assembly, "_assemble_rows", orig)
+        monkeypatch.setattr(assembly, "_assemble_rows_serial", serial)
         info = {}
         for name, args in zip(("V", "K"), calls):
-            rows = args[-2]
+            rows = assembly._interleaved(len(args[-2]))     # the parfor's row order
             starts = np.linspace(0, len(rows), 9).round().astype(np.int64)
             fs = {c: (lambda c=c: orig(*args[:-2], rows[starts[c]:starts[c + 1]],
                                        np.array([0, starts[c + 1] - starts[c]])))

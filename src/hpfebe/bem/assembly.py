@@ -8,6 +8,10 @@ and scattered.  Rows belong to test elements, so the loop over test elements run
 parallel without write conflicts (the test space must be discontinuous: W_hp): a numba
 parallel loop over chunks of rows (the mirror of the upper triangle and the
 sandwich W = T^T V T run as ``nogil`` kernels on Python threads: no parfor to compile).
+With one row chunk (one numba thread, as in every Snakemake job, or a mesh too small to
+pay for threads) the same loop runs as a plain compilation, ``_assemble_rows_serial``,
+and the parfor is compiled only if a process needs it (numba compiles at the first
+call): 5-8 s of a cold start instead of 20-30 s.
 
 Caching: numba's on-disk cache keys a function on the contents of its own file only, so
 the cached ``_assemble_rows`` keeps the machine code of the :mod:`.integration` and
@@ -18,6 +22,7 @@ the cached ``_assemble_rows`` keeps the machine code of the :mod:`.integration` 
 from __future__ import annotations
 
 import math
+import types
 from concurrent.futures import ThreadPoolExecutor
 from functools import lru_cache
 
@@ -29,7 +34,7 @@ from ..quadrature import rule_tables
 from ..spaces import P_MAX, DiscontinuousSpace, eval_basis, gll_tables, n_local
 from .integration import (ETA, NMAX, TOL, adjacent_block, coincident_block, far_block,
                           nearest_ends)
-from .kernels import LAPLACE_DL, kernel_batch
+from .kernels import INV_2PI, KP_LAPLACE_LOG_R, LAPLACE_DL, LAPLACE_SL, kernel_batch
 
 
 @njit(cache=True)
@@ -83,19 +88,24 @@ def _scatter(blk, dofs_i, dofs_j, mt, mr, d, out):
                     out[gk * d + c1, gl * d + c2] += blk[k * d + c1, l * d + c2]
 
 
-@njit(cache=True, parallel=True)
-def _assemble_rows(kernel, logc, haslog, kp, d, nodes, elements, normals, L, mid,
-                   kt, degt, dofs_t, kr, degr, dofs_r, symmetric,
-                   gx, gw, lx, lw, gll_x, gll_b, tab_t, tab_r, thr, out, rows, starts):
+_FUSE_DL = True     # see _rows; each compilation sets its own
+
+
+def _rows(kernel, logc, haslog, kp, d, nodes, elements, normals, L, mid,
+          kt, degt, dofs_t, kr, degr, dofs_r, symmetric,
+          gx, gw, lx, lw, gll_x, gll_b, tab_t, tab_r, thr, out, rows, starts):
     """Rows of the test elements ``rows`` (pairs j >= i only if ``symmetric``) into out,
     in chunks rows[starts[c]:starts[c+1]] run in parallel, each with its own scratch
     arrays (allocated once per chunk, not per row: the small-N overhead).  Rows belong to
     test elements, so chunks never write the same entry.
 
-    ``parallel=True`` costs compile time (the parfor), but numba compiles the parallel
-    loop body with ``noalias`` array arguments, which a plain ``@njit`` function cannot
-    request: the same code as a nogil function run by Python threads (tried for issue
-    14) was 1.4x slower at N = 1024 and up to 1.9x at N = 4096."""
+    Compiled twice (see ``_assemble_rows`` below): as a parfor, and without
+    ``parallel=True`` for one thread.  The parfor body gets ``noalias`` array
+    arguments, which a plain ``@njit`` function cannot request, so loops that are only
+    fast with noalias (LLVM vectorises them) differ between the two through the
+    compile-time constant ``_FUSE_DL``; the serial one keeps its values in scalars.
+    Measured (issue 14, one thread, CPU time, N = 64 ... 4096, p = 1): serial V 0.97-1.05x
+    and K 0.94-0.97x of the parfor's time, both 0.56-0.83x of the parfor before."""
     ne = elements.shape[0]
     nmax = gx.shape[0] - 1
     ntab = tab_t.shape[1] - 1
@@ -135,7 +145,50 @@ def _assemble_rows(kernel, logc, haslog, kp, d, nodes, elements, normals, L, mid
                     ny = 1
                     while ny < ntab and ry_ < thr[dr_, ny]:
                         ny += 1
-                if nx < ntab and ny < ntab:
+                if (nx < ntab and ny < ntab and d == 1
+                        and (kernel == LAPLACE_SL or (kernel == LAPLACE_DL and _FUSE_DL))):
+                    # Laplace: kernel (kernels.laplace_*, the same arithmetic), weights
+                    # and the trial-side sum fused per test point: no kernel_batch call
+                    # per pair, and scalars that the serial compilation (no noalias)
+                    # keeps in registers.  The parfor (noalias) vectorises the division
+                    # of the double layer in the loop below instead (_FUSE_DL False, a
+                    # compile-time constant of each compilation: K at N = 1024 90 ms
+                    # there against 121 ms fused; serial 83 ms fused, 139 ms unfused)
+                    Li = L[i]
+                    Lj = L[j]
+                    aJ, bJ = nodes[elements[j, 0]], nodes[elements[j, 1]]
+                    nJ0, nJ1 = normals[j, 0], normals[j, 1]
+                    kp0 = kp[KP_LAPLACE_LOG_R]
+                    lc0 = logc[0]
+                    for a in range(nx):
+                        x0 = aI[0] + gx[nx, a] * (bI[0] - aI[0])
+                        x1 = aI[1] + gx[nx, a] * (bI[1] - aI[1])
+                        wa = gw[nx, a]
+                        for b in range(ny):
+                            rx = x0 - (aJ[0] + gx[ny, b] * (bJ[0] - aJ[0]))
+                            ry = x1 - (aJ[1] + gx[ny, b] * (bJ[1] - aJ[1]))
+                            if kernel == LAPLACE_SL:
+                                kv = kp0
+                            else:
+                                kv = INV_2PI * (rx * nJ0 + ry * nJ1) / (rx * rx + ry * ry)
+                            w = wa * gw[ny, b] * Li * Lj
+                            if haslog:
+                                kv = w * (kv + lc0 * (0.5 * math.log(rx * rx + ry * ry)))
+                            else:
+                                kv = kv * w
+                            rxs[b] = kv
+                        for l in range(mr):
+                            acc = 0.0
+                            for b in range(ny):
+                                acc += rxs[b] * tab_r[pr, ny, b, l]
+                            tmp[a, l, 0] = acc
+                    for k in range(mt):
+                        for l in range(mr):
+                            acc = 0.0
+                            for a in range(nx):
+                                acc += tab_t[pt, nx, a, k] * tmp[a, l, 0]
+                            blk[k, l] = acc
+                elif nx < ntab and ny < ntab:
                     aJ, bJ = nodes[elements[j, 0]], nodes[elements[j, 1]]
                     for a in range(nx):
                         x0 = aI[0] + gx[nx, a] * (bI[0] - aI[0])
@@ -143,16 +196,25 @@ def _assemble_rows(kernel, logc, haslog, kp, d, nodes, elements, normals, L, mid
                         for b in range(ny):
                             rxs[a * ny + b] = x0 - (aJ[0] + gx[ny, b] * (bJ[0] - aJ[0]))
                             rys[a * ny + b] = x1 - (aJ[1] + gx[ny, b] * (bJ[1] - aJ[1]))
-                    kernel_batch(kernel, rxs, rys, nx * ny, normals[i], normals[j], kp, Kq)
-                    for q in range(nx * ny):
-                        w = gw[nx, q // ny] * gw[ny, q % ny] * L[i] * L[j]
-                        if haslog:
-                            lr = 0.5 * math.log(rxs[q] * rxs[q] + rys[q] * rys[q])
-                            for c in range(d * d):
-                                Kq[q, c] = w * (Kq[q, c] + logc[c] * lr)
-                        else:
-                            for c in range(d * d):
-                                Kq[q, c] *= w
+                    if kernel == LAPLACE_DL:     # kernels.laplace_double_layer
+                        nJ0, nJ1 = normals[j, 0], normals[j, 1]
+                        for q in range(nx * ny):
+                            Kq[q, 0] = INV_2PI * (rxs[q] * nJ0 + rys[q] * nJ1) / (
+                                rxs[q] * rxs[q] + rys[q] * rys[q])
+                    else:
+                        kernel_batch(kernel, rxs, rys, nx * ny, normals[i], normals[j], kp,
+                                     Kq)
+                    for a in range(nx):       # (q // ny, q % ny per point: two divisions)
+                        for b in range(ny):
+                            q = a * ny + b
+                            w = gw[nx, a] * gw[ny, b] * L[i] * L[j]
+                            if haslog:
+                                lr = 0.5 * math.log(rxs[q] * rxs[q] + rys[q] * rys[q])
+                                for c in range(d * d):
+                                    Kq[q, c] = w * (Kq[q, c] + logc[c] * lr)
+                            else:
+                                for c in range(d * d):
+                                    Kq[q, c] *= w
                     # blk = sum_a phi_k(a) sum_b Kq[a, b] psi_l(b): integration.contract_block
                     # written out on the tables (its call here cost 1.3-1.9x at N = 4096)
                     for a in range(nx):
@@ -195,6 +257,30 @@ def _assemble_rows(kernel, logc, haslog, kp, d, nodes, elements, normals, L, mid
                 _scatter(blk, dofs_t[i], dofs_r[j], mt, mr, d, out)
 
 
+def _renamed(fn, name: str, **constants):
+    """A copy of the Python function ``fn`` under another name, with module globals
+    replaced by ``constants`` (numba compiles globals as constants): numba's on-disk
+    cache files are named after the function's qualified name, so that two dispatchers
+    compiled from one source need two names."""
+    g = types.FunctionType(fn.__code__, {**fn.__globals__, **constants}, name,
+                           fn.__defaults__, fn.__closure__)
+    g.__qualname__ = name
+    g.__module__ = fn.__module__
+    g.__doc__ = fn.__doc__
+    return g
+
+
+# one source, two compilations (numba compiles a dispatcher at its first call, so the one
+# a process never calls costs nothing): the parfor for several row chunks on several
+# threads, and a plain loop (prange is range without parallel=True) for one chunk - the
+# single-thread case of every Snakemake job and test process, whose parfor compile was
+# 20 s of a cold start (issue 14)
+_assemble_rows = njit(cache=True, parallel=True)(
+    _renamed(_rows, "_assemble_rows", _FUSE_DL=False))
+_assemble_rows_serial = njit(cache=True, nogil=True)(
+    _renamed(_rows, "_assemble_rows_serial", _FUSE_DL=True))
+
+
 @njit(cache=True, nogil=True)
 def _mirror_rows(A, blocks):
     """A[r, c] = A[c, r] for r > c in the row tiles ``blocks`` (64 rows each), tile by tile:
@@ -215,8 +301,9 @@ def _chunk_starts(n: int, work: float) -> np.ndarray:
     """Boundaries of the row chunks of the parallel loop: one chunk when ``work`` (element
     pairs) is too small to pay for threads, else 4 per thread."""
     nt = numba.get_num_threads()
-    nchunks = 1 if nt <= 1 or work < MIN_PAIRS_PER_THREAD * nt else min(n, 4 * nt)
-    return np.linspace(0, n, nchunks + 1).round().astype(np.int64)
+    if nt <= 1 or work < MIN_PAIRS_PER_THREAD * nt:
+        return np.array([0, n], dtype=np.int64)
+    return np.linspace(0, n, min(n, 4 * nt) + 1).round().astype(np.int64)
 
 
 def _interleaved(n: int) -> np.ndarray:
@@ -291,6 +378,29 @@ def _order_thresholds(degmax: int):
     return thr
 
 
+@njit(cache=True)
+def _element_geometry(nodes, elements):
+    """(normals, L, mid) of the elements: the same floats as ``mesh.normals``,
+    ``np.hypot`` of the edge vectors and ``0.5 * (a + b)`` (checked bitwise), in one call
+    instead of ~15 numpy operations (15 us of a 16-element assembly)."""
+    ne = elements.shape[0]
+    normals = np.empty((ne, 2))
+    L = np.empty(ne)
+    mid = np.empty((ne, 2))
+    for e in range(ne):
+        a0, a1 = nodes[elements[e, 0], 0], nodes[elements[e, 0], 1]
+        b0, b1 = nodes[elements[e, 1], 0], nodes[elements[e, 1], 1]
+        d0 = b0 - a0
+        d1 = b1 - a1
+        L[e] = math.hypot(d0, d1)
+        nrm = math.sqrt(d0 * d0 + d1 * d1)      # np.linalg.norm of BoundaryMesh.lengths
+        normals[e, 0] = d1 / nrm
+        normals[e, 1] = -(d0 / nrm)
+        mid[e, 0] = 0.5 * (a0 + b0)
+        mid[e, 1] = 0.5 * (a1 + b1)
+    return normals, L, mid
+
+
 def _space_arrays(space):
     # local functions per element: n_local(kind, p_I) with p_I the element degree
     return space.kind, np.ascontiguousarray(space.mesh.degrees), space.elem_dofs
@@ -313,31 +423,36 @@ def assemble(kernel: int, logc, kp, test, trial, d: int = 1,
     if symmetric and test is not trial:
         raise ValueError("symmetric=True requires test is trial")
     mesh = test.mesh
-    if mesh.degrees.max() > P_MAX:
-        raise ValueError(f"degree p must be <= {P_MAX}, got {mesh.degrees.max()}")
-    gx, gw, lx, lw = rules(log_rule_count(int(mesh.degrees.max())))
+    pmax = int(mesh.degrees.max())
+    if pmax > P_MAX:
+        raise ValueError(f"degree p must be <= {P_MAX}, got {pmax}")
+    gx, gw, lx, lw = rules(log_rule_count(pmax))
     gll_x, gll_b = gll_tables(P_MAX)
     logc = np.ascontiguousarray(np.asarray(logc, dtype=float).reshape(d * d))
     kp = np.ascontiguousarray(np.asarray(kp, dtype=float).reshape(-1))
     kt, degt, dofs_t = _space_arrays(test)
     kr, degr, dofs_r = _space_arrays(trial)
     out = np.zeros((test.ndof * d, trial.ndof * d))
-    pmax = int(mesh.degrees.max())
     nodes, elements = mesh.nodes, mesh.elements
-    a, b = nodes[elements[:, 0]], nodes[elements[:, 1]]
-    L = np.hypot(b[:, 0] - a[:, 0], b[:, 1] - a[:, 1])
-    mid = np.ascontiguousarray(0.5 * (a + b))
+    normals, L, mid = _element_geometry(nodes, elements)
     ne = elements.shape[0]
-    args = (kernel, logc, bool(np.any(logc != 0.0)), kp, d, nodes, elements,
-            np.ascontiguousarray(mesh.normals), L, mid, kt, degt, dofs_t, kr, degr, dofs_r,
-            symmetric, gx, gw, lx, lw, gll_x, gll_b, _far_tables(kt, pmax),
-            _far_tables(kr, pmax), _order_thresholds(pmax), out)
-    _assemble_rows(*args, _interleaved(ne),
-                   _chunk_starts(ne, ne * ne * (0.5 if symmetric else 1.0)))
-    if symmetric:
-        # dofs of W_hp grow with the element index, so the pairs j >= i filled the
-        # upper triangle
-        _mirror_upper(out)
+    args = (kernel, logc, bool(logc.any()), kp, d, nodes, elements, normals, L, mid,
+            kt, degt, dofs_t, kr, degr, dofs_r, symmetric, gx, gw, lx, lw, gll_x, gll_b,
+            _far_tables(kt, pmax), _far_tables(kr, pmax), _order_thresholds(pmax))
+    starts = _chunk_starts(ne, ne * ne * (0.5 if symmetric else 1.0))
+    if len(starts) == 2:
+        # one chunk (one thread, or too little work for threads): the serial compilation
+        # (the order of the rows does not change a bit of the result: each row is one
+        # test element's, summed over j in order)
+        _assemble_rows_serial(*args, out, np.arange(ne), starts)
+        if symmetric:
+            _mirror_rows(out, np.arange((out.shape[0] + 63) // 64))
+    else:
+        _assemble_rows(*args, out, _interleaved(ne), starts)
+        if symmetric:
+            # dofs of W_hp grow with the element index, so the pairs j >= i filled the
+            # upper triangle
+            _mirror_upper(out)
     if not np.all(np.isfinite(out)):
         raise FloatingPointError("assembly produced non-finite entries "
                                  "(degenerate geometry or degree too high?)")
@@ -400,14 +515,42 @@ def _sandwich_rows(indptr, indices, data, V, out, rows):
             out[j, i] = acc
 
 
+@njit(cache=True)
+def _transpose_csr(indptr, indices, data, ncols):
+    """CSR arrays of the transpose of a CSR matrix with ``ncols`` columns, column indices
+    sorted (a counting sort over the rows in order): ``T.T.tocsr()`` + ``sort_indices``
+    without scipy's ~25 us of checks."""
+    nnz = indptr[-1]
+    ptr = np.zeros(ncols + 1, np.int64)
+    for a in range(nnz):
+        ptr[indices[a] + 1] += 1
+    for c in range(ncols):
+        ptr[c + 1] += ptr[c]
+    fill = ptr[:-1].copy()
+    idx = np.empty(nnz, np.int64)
+    val = np.empty(nnz)
+    for r in range(indptr.shape[0] - 1):
+        for a in range(indptr[r], indptr[r + 1]):
+            c = indices[a]
+            idx[fill[c]] = r
+            val[fill[c]] = data[a]
+            fill[c] += 1
+    return ptr, idx, val
+
+
 def sandwich(T, V: np.ndarray) -> np.ndarray:
     """T^T V T for sparse T (n_W x n_V) and dense symmetric V (n_W x n_W), exactly
     symmetric: the hypersingular operator W = T^T V T from the single layer V of the
     arc-length derivatives (T: :meth:`ContinuousSpace.derivative_matrix`)."""
-    R = T.T.tocsr()
-    R.sort_indices()
-    out = np.empty((R.shape[0], R.shape[0]))
-    n = R.shape[0]
-    _threaded(_sandwich_rows, (R.indptr, R.indices, R.data, np.ascontiguousarray(V), out),
-              _interleaved(n), 0.5 * n * n)
+    T = T.tocsr()
+    if T.has_canonical_format:
+        indptr, indices, data = _transpose_csr(T.indptr, T.indices, T.data, T.shape[1])
+    else:     # duplicates summed as scipy does
+        R = T.T.tocsr()
+        R.sort_indices()
+        indptr, indices, data = R.indptr, R.indices, R.data
+    n = T.shape[1]
+    out = np.empty((n, n))
+    _threaded(_sandwich_rows, (indptr, indices, data, np.ascontiguousarray(V), out),
+              np.arange(n) if numba.get_num_threads() <= 1 else _interleaved(n), 0.5 * n * n)
     return out

@@ -24,10 +24,9 @@ function each (the split of HILBERT and the ETH 2D parametric BEM code):
   n = ln(1/tol) / (2 ln rho) + (degree + 1)/2.
 
 ``kernel`` is an integer id of :mod:`hpfebe.bem.kernels`; the regular part k_reg is
-evaluated by ``kernel_batch`` once per batch of quadrature points (single points pass
-``np.int64(1)`` as the count: a literal 1 compiled the six kernel functions a second
-time, for Literal[int](1) - 2 s of a cold start), ``logc`` is the (d*d)
-array of the log coefficients A.
+evaluated by ``kernel_batch`` once per batch of quadrature points, and by
+``kernel_point`` (scalar arguments: a one-point batch call cost ~150 ns) at the single
+points of the singular rules; ``logc`` is the (d*d) array of the log coefficients A.
 """
 
 from __future__ import annotations
@@ -38,7 +37,7 @@ import numpy as np
 from numba import njit
 
 from ..spaces import eval_basis, n_local
-from .kernels import kernel_batch
+from .kernels import kernel_batch, kernel_point
 
 TOL = 1e-16          # target relative quadrature error per direction
 NMAX = 48            # largest Gauss order in tables
@@ -345,7 +344,13 @@ def parallel_block(kernel, logc, haslog, kp, d, aI, bI, nI, aJ, bJ, nJ, s0, s1, 
     zs = np.empty(5)
     zs[0], zs[1], zs[2], zs[3] = xi0 - eta1, xi0 - eta0, xi1 - eta1, xi1 - eta0
     zs[4] = min(max(0.0, zs[0]), zs[3])
-    zs.sort()
+    for q in range(1, 5):       # insertion sort, as zs.sort() (whose quicksort compiled
+        zq = zs[q]              # three more functions: 1.2 s of a cold start)
+        r = q
+        while r > 0 and zq < zs[r - 1]:
+            zs[r] = zs[r - 1]
+            r -= 1
+        zs[r] = zq
     for piece in range(4):
         za, zb = zs[piece], zs[piece + 1]
         hz = zb - za
@@ -363,7 +368,7 @@ def parallel_block(kernel, logc, haslog, kp, d, aI, bI, nI, aJ, bJ, nJ, s0, s1, 
                 continue
             rxs[0] = z * tx - wx_
             rys[0] = z * ty - wy_
-            kernel_batch(kernel, rxs, rys, np.int64(1), nI, nJ, kp, Kq)
+            kernel_point(kernel, rxs[0], rys[0], nI[0], nI[1], nJ[0], nJ[1], kp, Kq)
             if haslog:
                 lr = 0.5 * math.log(rxs[0] * rxs[0] + rys[0] * rys[0])
                 for c in range(dd):
@@ -404,8 +409,8 @@ def coincident_block(kernel, logc, haslog, kp, d, aI, bI, nI, kt, pt, kr, pr,
     dd = d * d
     logL = math.log(L)
     # regular part: Gauss in z and tau; log z part: log rule in z.  The two parts are
-    # written out here and in adjacent_block, with the literal one-point kernel_batch
-    # call (LLVM unrolls it): the same code in inline="always" helpers made V + K + W
+    # written out here and in adjacent_block, with the one-point kernel_point call:
+    # the same code in inline="always" helpers made V + K + W
     # 1.2x slower at N = 64, p = 1 (issue 14; these pairs dominate small N)
     for part in range(2):
         nzz = nz if part == 0 else nl
@@ -429,7 +434,7 @@ def coincident_block(kernel, logc, haslog, kp, d, aI, bI, nI, kt, pt, kr, pr,
                     if part == 0:
                         rxs[0] = sgn * z * L * ex
                         rys[0] = sgn * z * L * ey
-                        kernel_batch(kernel, rxs, rys, np.int64(1), nI, nI, kp, Kq)
+                        kernel_point(kernel, rxs[0], rys[0], nI[0], nI[1], nI[0], nI[1], kp, Kq)
                         if haslog:
                             for c in range(dd):
                                 Kq[0, c] += logc[c] * logL
@@ -541,7 +546,7 @@ def adjacent_block(kernel, logc, haslog, kp, d, aI, bI, nI, aJ, bJ, nJ, vI, vJ,
                     if part == 0:
                         rxs[0] = ell * (a_loc * dIx - b_loc * dJx)
                         rys[0] = ell * (a_loc * dIy - b_loc * dJy)
-                        kernel_batch(kernel, rxs, rys, np.int64(1), nI, nJ, kp, Kq)
+                        kernel_point(kernel, rxs[0], rys[0], nI[0], nI[1], nJ[0], nJ[1], kp, Kq)
                         if haslog:
                             if tri == 0:
                                 R = math.hypot(dIx - w * dJx, dIy - w * dJy)
@@ -556,13 +561,12 @@ def adjacent_block(kernel, logc, haslog, kp, d, aI, bI, nI, aJ, bJ, nJ, vI, vJ,
                     _add_point(wt, phi, psi, mt, mr, d, Kq, out)
     # the part of the longer element outside the Duffy square is a far pair
     # parametrised from the shared vertex (rI, rJ of far_block): exact near it
-    if LI > LJ * (1.0 + 1e-13):
-        far_block(kernel, logc, haslog, kp, d, aI, bI, nI, aJ, bJ, nJ, fI, 1.0, 0.0, 1.0,
-                  vI == 1, vJ == 1,
-                  kt, pt, kr, pr, gx, gw, gll_x, gll_b, Phi, Psi, Kq, tmp, rxs, rys, wx, ww,
-                  stack, out)
-    elif LJ > LI * (1.0 + 1e-13):
-        far_block(kernel, logc, haslog, kp, d, aI, bI, nI, aJ, bJ, nJ, 0.0, 1.0, fJ, 1.0,
+    # (one call site: LLVM inlines far_block into each, and each copy is compile time)
+    longer_I = LI > LJ * (1.0 + 1e-13)
+    if longer_I or LJ > LI * (1.0 + 1e-13):
+        s0 = fI if longer_I else 0.0
+        g0 = 0.0 if longer_I else fJ
+        far_block(kernel, logc, haslog, kp, d, aI, bI, nI, aJ, bJ, nJ, s0, 1.0, g0, 1.0,
                   vI == 1, vJ == 1,
                   kt, pt, kr, pr, gx, gw, gll_x, gll_b, Phi, Psi, Kq, tmp, rxs, rys, wx, ww,
                   stack, out)
