@@ -36,7 +36,7 @@ from __future__ import annotations
 import logging
 import math
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 import pandas as pd
@@ -48,6 +48,7 @@ from hpfebe import BoundaryMesh
 from hpfebe.adaptivity import adapt
 from hpfebe.analysis.rates import loglog_interpolate
 from hpfebe.adaptivity.bem_estimator import (INDICATOR_VARIANTS, consistency_weight,
+                                             lame_boundary_residuals,
                                              lame_contact_indicators, norm_B, true_error)
 from hpfebe.bem.lame import LameBEM
 from hpfebe.contact.friction import solve_friction
@@ -194,21 +195,47 @@ def solve_on(mesh, prm: Params, gap, eps):
                 newton=int(sum(res.iterations)), wall=time.perf_counter() - t0)
 
 
-def adaptive_run(example, d, prm: Params, eps, n_steps, weight=1.0):
+def _mesh_key(mesh) -> tuple:
+    return (mesh.nodes.tobytes(), mesh.elements.tobytes(), mesh.degrees.tobytes(),
+            tuple(mesh.labels))
+
+
+def solve_memo(memo: dict | None, mesh, prm: Params, example: int, d: float, eps):
+    """``solve_on(mesh, prm, gap_function(example, d), eps)``, computed once per (mesh,
+    example, d, eps) in ``memo`` (the indicator variants start on the same mesh and
+    often refine alike; the uniform n_initial mesh is step 0): a shallow copy of the
+    state (own eta / t_est; op, U, Psi, res shared, read only).  memo None: no cache."""
+    if memo is None:
+        return solve_on(mesh, prm, gap_function(example, d), eps)
+    solves = memo.setdefault("solves", {})
+    key = (example, d, eps, _mesh_key(mesh))
+    if key not in solves:
+        solves[key] = solve_on(mesh, prm, gap_function(example, d), eps)
+    return dict(solves[key])
+
+
+def adaptive_run(example, d, prm: Params, eps, n_steps, weight=1.0, memo=None):
     """Algorithm 3.2 with n_steps refinements (n_steps + 1 solves).  Returns a list of
-    per-mesh records: step, mesh, state, eta, eta_total, marked (refined elements)."""
+    per-mesh records: step, mesh, state, eta, eta_total, marked (refined elements).
+    ``memo``: a dict shared by runs, to solve and to evaluate the (weight-independent)
+    boundary residuals of the indicators once per mesh (:func:`solve_memo`)."""
     gap = gap_function(example, d)
     states = []
+    residuals = {} if memo is None else memo.setdefault("residuals", {})
 
     def _solve(mesh):
-        st = solve_on(mesh, prm, gap, eps)
+        st = solve_memo(memo, mesh, prm, example, d, eps)
         states.append(st)
         return st, st["ndof"]
 
     def _estimate(mesh, st):
         t0 = time.perf_counter()
+        key = (example, d, eps, _mesh_key(mesh))
+        if key not in residuals:
+            residuals[key] = lame_boundary_residuals(st["op"], st["U"], st["Psi"])
         st["eta"] = lame_contact_indicators(st["op"], st["U"], st["Psi"], gap, eps, eps,
-                                            mu_f=prm.mu_f, weight=weight)
+                                            mu_f=prm.mu_f, weight=weight,
+                                            residuals=residuals[key])
         st["t_est"] = time.perf_counter() - t0
         return st["eta"]
 
@@ -462,6 +489,7 @@ class _Setup:
     eps_alt: float
     d_main: float
     w: dict
+    memo: dict = field(default_factory=dict)    # solves and residuals per mesh (solve_memo)
 
 
 def _setup(prm: Params) -> _Setup:
@@ -478,13 +506,14 @@ def _run_example1(s: _Setup):
     the shorter run: refinement is deterministic), the other d and the C_pen_alt run."""
     prm = s.prm
     n_ext = max(prm.n_steps, prm.n_steps_extended)
-    ext = {v: adaptive_run(1, s.d_main, prm, s.eps, n_ext, weight=s.w[v]) for v in s.variants}
+    ext = {v: adaptive_run(1, s.d_main, prm, s.eps, n_ext, weight=s.w[v], memo=s.memo)
+           for v in s.variants}
     ex1 = {(s.d_main, v): _truncate(ext[v], prm.n_steps) for v in s.variants}
     ex1.update({(d, s.primary): adaptive_run(1, d, prm, s.eps, prm.n_steps,
-                                             weight=s.w[s.primary])
+                                             weight=s.w[s.primary], memo=s.memo)
                 for d in prm.example1_d[1:]})
-    ex1_alt = adaptive_run(1, s.d_main, prm, s.eps_alt, prm.n_steps, weight=s.w[s.primary]) \
-        if prm.C_pen_alt > 0 else None
+    ex1_alt = adaptive_run(1, s.d_main, prm, s.eps_alt, prm.n_steps, weight=s.w[s.primary],
+                           memo=s.memo) if prm.C_pen_alt > 0 else None
     return ext, ex1, ex1_alt
 
 
@@ -499,7 +528,7 @@ def _error_table(s: _Setup, ext):
     ref = solve_on(ref_mesh, prm, gap1, s.eps)
     rows = []
     for n in sorted(set(prm.n_uniform) | {prm.n_190}):
-        st = solve_on(initial_mesh(n), prm, gap1, s.eps)
+        st = solve_memo(s.memo, initial_mesh(n), prm, 1, s.d_main, s.eps)
         rows.append(dict(refinement="uniform", n=n, step=np.nan,
                          beyond_thesis=n > prm.n_190, dof=st["ndof"], norm_B=st["norm_B"],
                          err_true=reference_error(st, ref), newton_iterations=st["newton"],
@@ -781,8 +810,8 @@ def run(config: dict, quick: bool = False) -> list[ArtefactResult]:
     errtab, ref, ref_mesh, dof190 = _error_table(s, ext)
     times["ex1"] = time.perf_counter() - t_run
     t2 = time.perf_counter()
-    ex2 = {v: adaptive_run(2, prm.example2_d, prm, s.eps, prm.n_steps, weight=s.w[v])
-           for v in s.variants}
+    ex2 = {v: adaptive_run(2, prm.example2_d, prm, s.eps, prm.n_steps, weight=s.w[v],
+                           memo=s.memo) for v in s.variants}
     times["ex2"] = time.perf_counter() - t2
     ranges, field1, field2 = _interior_fields(s, ex1, ex1_alt, ex2[s.primary])
     run_s = time.perf_counter() - t_run

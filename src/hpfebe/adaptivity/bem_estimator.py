@@ -235,12 +235,15 @@ def solve_lame_mixed(op, traction, dirichlet=("D",), u_dirichlet=None):
 
 
 def lame_bem_indicators(op, U, Psi, tractions: dict, nq: int | None = None,
-                        return_parts: bool = False, delta: float = 1e-5):
+                        return_parts: bool = False, delta: float = 1e-5,
+                        residuals: dict | None = None):
     """eta_h(I) of (3.107) for Lame (vector residuals, Euclidean norm); ``tractions`` maps
     labels to callables (x, n) -> (n, 2) or (x, n, elem, t) -> (n, 2) (t_hat on "N",
-    P_n n + P_t t on "C", see :func:`bem_indicators`)."""
-    return _indicators(op.mesh, lame_boundary_residuals(op, U, Psi, nq, delta), tractions,
-                       2, return_parts)
+    P_n n + P_t t on "C", see :func:`bem_indicators`).  ``residuals``: the result of
+    ``lame_boundary_residuals(op, U, Psi, nq, delta)`` if already computed (the expensive
+    part: potentials at every quadrature point; it does not depend on the data)."""
+    r = lame_boundary_residuals(op, U, Psi, nq, delta) if residuals is None else residuals
+    return _indicators(op.mesh, r, tractions, 2, return_parts)
 
 
 def error_measure_B_lame(op, U, Psi, u_exact, traction_exact, extra: int = 3) -> float:
@@ -315,17 +318,21 @@ def consistency_weight(variant: str, E: float, nu: float, plane: str = "strain")
 
 def lame_contact_indicators(op, U, Psi, gap, eps_n: float, eps_t: float, mu_f=None, F=None,
                             weight: float = 1.0, contact_label: str = "C",
-                            tractions: dict | None = None, nq: int | None = None):
+                            tractions: dict | None = None, nq: int | None = None,
+                            residuals: dict | None = None):
     """eta_h(I) of (3.107) for a Lame BEM body in penalty contact with a rigid obstacle:
     (h_I ||P_n n + P_t t - S_hat U||^2 + weight^2 h_I ||d/ds (V Psi - (K + 1/2) U)||^2)^(1/2)
     with the datum of :func:`contact_traction` on ``contact_label`` and further data
-    ``tractions`` (label -> callable, e.g. t_hat on "N")."""
+    ``tractions`` (label -> callable, e.g. t_hat on "N").  ``residuals``: precomputed
+    ``lame_boundary_residuals(op, U, Psi, nq)`` (shared by indicator variants that differ
+    in ``weight`` only)."""
     weight = float(weight)
     if not (np.isfinite(weight) and weight > 0):
         raise ValueError(f"weight must be finite and positive, got {weight!r}")
     data = dict(tractions or {})
     data[contact_label] = contact_traction(op, U, gap, eps_n, eps_t, mu_f=mu_f, F=F)
-    _, parts = lame_bem_indicators(op, U, Psi, data, nq=nq, return_parts=True)
+    _, parts = lame_bem_indicators(op, U, Psi, data, nq=nq, return_parts=True,
+                                   residuals=residuals)
     return np.sqrt(parts["traction"] ** 2 + (weight * parts["consistency"]) ** 2)
 
 

@@ -10,14 +10,26 @@ Each element is bisected until the point is at least one sub-element length away
 Gauss with an order that grows with log(size / distance) (the rule of
 :func:`hpfebe.bem.integration._order`), so the accuracy holds uniformly up to (not on)
 the boundary.
+
+Speed (the same sums, bitwise): most point-element pairs are far (one panel, the whole
+element); for them the Gauss points, weights and density values per element and order
+are tabulated once per call (:func:`_far_tables`) and the order is read off thresholds
+of ``_order`` (:func:`_order_thresholds`), the Laplace kernels are inlined, and the
+points are split over numba.get_num_threads() Python threads running a nogil kernel
+(:func:`_potential_rows`; no parfor to compile).  Representation formula of
+Example 2 (50,181 points x 1,040 elements, single thread): SL 7.2 -> 1.6 s, DL 8.3 ->
+1.2 s.
 """
 
 from __future__ import annotations
 
 import math
+from concurrent.futures import ThreadPoolExecutor
+from functools import lru_cache
 
+import numba
 import numpy as np
-from numba import njit, prange
+from numba import njit
 
 from ..spaces import P_MAX, eval_basis, gll_tables, n_local
 from .assembly import rules
@@ -86,6 +98,18 @@ def _lame_grad_kernels(rx, ry, ny0, ny1, lam, mu, c1, c2, double, out):
             out[(i * 2 + m) * 2 + 1] = s01 * ny0 + s11 * ny1
 
 
+@njit(cache=True, inline="always")
+def _laplace_sl(rx, ry, kp):
+    """Laplace single-layer kernel G(r) = log(R) / (2 pi) - log|r| / (2 pi)."""
+    return kp[KP_LAPLACE_LOG_R] - INV_2PI * 0.5 * math.log(rx * rx + ry * ry)
+
+
+@njit(cache=True, inline="always")
+def _laplace_dl(rx, ry, ny0, ny1):
+    """Laplace double-layer kernel d_{n_y} G(r) = r . n_y / (2 pi |r|^2)."""
+    return INV_2PI * (rx * ny0 + ry * ny1) / (rx * rx + ry * ry)
+
+
 @njit(cache=True)
 def pot_kernel(kid, rx, ry, ny0, ny1, kp, out):
     """Full kernel at r = x - y (x off Gamma): Laplace G and d_{n_y} G (kp = [log(R)/(2 pi)]),
@@ -93,9 +117,9 @@ def pot_kernel(kid, rx, ry, ny0, ny1, kp, out):
     :mod:`.kernels`), its y-traction (double layer), or the x-gradients of both (nout = 4:
     rows (i, m) = d/dx_m of component i)."""
     if kid == POT_LAPLACE_SL:
-        out[0] = kp[KP_LAPLACE_LOG_R] - INV_2PI * 0.5 * math.log(rx * rx + ry * ry)
+        out[0] = _laplace_sl(rx, ry, kp)
     elif kid == POT_LAPLACE_DL:
-        out[0] = INV_2PI * (rx * ny0 + ry * ny1) / (rx * rx + ry * ry)
+        out[0] = _laplace_dl(rx, ry, ny0, ny1)
     elif kid == POT_LAME_SL:
         _log_rr(rx, ry, kp[KP_C1_LOG_R] - 0.5 * kp[KP_C1] * math.log(rx * rx + ry * ry),
                 kp[KP_C1_C2], out)
@@ -111,31 +135,186 @@ def pot_kernel(kid, rx, ry, ny0, ny1, kp, out):
         raise ValueError("unknown potential kernel id")
 
 
-@njit(cache=True, parallel=True)
-def _potential(kid, kp, d, nout, pts, nodes, elements, normals, degrees, kind, dofs,
-               coef, gx, gw, gll_x, gll_b):
-    npts = pts.shape[0]
+@lru_cache(maxsize=None)
+def _far_basis(kind: int, pmax: int, nf: int):
+    """(off, tab): tab[p, off[n] + k, j] = basis function j of degree p (``eval_basis``)
+    at the k-th n-point Gauss node of the whole element, n <= nf (zero for j beyond the
+    local basis)."""
+    gx = rules()[0]
+    gll_x, gll_b = gll_tables(P_MAX)
+    off = np.concatenate([[0, 0], np.cumsum(np.arange(1, nf + 1))]).astype(np.int64)
+    tab = np.zeros((pmax + 1, off[-1], pmax + 1))
+    for p in range(1, pmax + 1):
+        for n in range(1, nf + 1):
+            for k in range(n):
+                s = 0.0 + (1.0 - 0.0) * gx[n, k]      # as the panel loop forms it
+                eval_basis(kind, p, 2.0 * s - 1.0, gll_x, gll_b, tab[p, off[n] + k])
+    tab.setflags(write=False)
+    return off, tab
+
+
+def _far_tables(mesh, space, coef, nf: int):
+    """(off, Y, FV) of the far pairs (the point at least one element length away: the
+    whole element is one panel, s in [0, 1]): for element e and Gauss order n <= nf, the
+    Gauss points Y[e, off[n] + k] = a + s (b - a) and the density values FV[e, off[n] +
+    k] = f(y) - the very floating-point operations of the panel loop of
+    :func:`_potential_rows`, so a far pair reads them instead of recomputing them for
+    every evaluation point (bitwise the same sums)."""
+    gx = rules()[0]
+    off, tab = _far_basis(space.kind, int(mesh.degrees.max()), nf)
+    m = int(off[-1])
+    s = np.concatenate([0.0 + (1.0 - 0.0) * gx[n, :n] for n in range(1, nf + 1)])
+    a = mesh.nodes[mesh.elements[:, 0]]
+    u = mesh.nodes[mesh.elements[:, 1]] - a
+    Y = np.empty((len(a), m, 2))
+    Y[:, :, 0] = a[:, 0, None] + s[None, :] * u[:, 0, None]
+    Y[:, :, 1] = a[:, 1, None] + s[None, :] * u[:, 1, None]
+    phi = tab[mesh.degrees]                                  # (ne, m, pmax + 1)
+    dofs = space.elem_dofs
+    nl = np.array([n_local(space.kind, int(p)) for p in mesh.degrees])
+    FV = np.zeros((len(a), m, coef.shape[1]))
+    for j in range(dofs.shape[1]):
+        on = (dofs[:, j] >= 0) & (j < nl)
+        FV[on] += phi[on, :, j, None] * coef[dofs[on, j]][:, None, :]
+    return off, np.ascontiguousarray(Y), FV
+
+
+@lru_cache(maxsize=None)
+def _order_thresholds(dmax: int, nf: int, nmax: int) -> np.ndarray:
+    """thr2[deg, n]: the square of the smallest ratio >= 2 with _order(ratio, deg, nmax)
+    <= n (inf if none), by bisection on :func:`hpfebe.bem.integration._order` itself to
+    a relative 1e-13.  A far pair reads its order off these unless its ratio lies within
+    a relative 1e-9 of one (then _order is called): the order of the direct call either
+    way."""
+    thr2 = np.full((dmax + 1, nf + 1), np.inf)
+    for deg in range(dmax + 1):
+        for n in range(1, nf + 1):
+            lo, hi = 2.0, 1e300
+            if _order(lo, deg, nmax) <= n:
+                thr2[deg, n] = lo * lo
+                continue
+            if _order(hi, deg, nmax) > n:
+                continue
+            while hi - lo > 1e-13 * hi:
+                mid = math.sqrt(lo) * math.sqrt(hi)
+                if not lo < mid < hi:
+                    mid = 0.5 * (lo + hi)
+                lo, hi = (lo, mid) if _order(mid, deg, nmax) <= n else (mid, hi)
+            thr2[deg, n] = hi * hi
+    thr2.setflags(write=False)
+    return thr2
+
+
+@njit(cache=True, inline="always")
+def _far_order(dx, dy, L, deg, nmax, nf, thr2):
+    """Gauss order of the far pair (point at offset (dx, dy) from its nearest point on
+    an element of length L: one panel), or -1 for a near pair: exactly
+    ``_order(2 hypot(dx, dy) / L, deg, nmax)`` when hypot(dx, dy) >= L (the test of
+    point_panels), read off ``thr2`` unless within round-off of a threshold."""
+    d2 = dx * dx + dy * dy
+    L2 = L * L
+    if d2 < L2 * (1.0 - 1e-9):
+        return -1
+    if d2 <= L2 * (1.0 + 1e-9):         # round-off band: the exact test
+        dist = math.hypot(dx, dy)
+        if dist < L:
+            return -1
+        return _order(2.0 * dist / L, deg, nmax)
+    r2 = 4.0 * d2 / L2
+    for n in range(1, nf + 1):
+        t = thr2[deg, n]
+        if t <= r2:
+            if r2 <= t * (1.0 + 1e-9) or (n > 1 and r2 >= thr2[deg, n - 1] * (1.0 - 1e-9)):
+                return _order(2.0 * math.hypot(dx, dy) / L, deg, nmax)
+            return n
+    return _order(2.0 * math.hypot(dx, dy) / L, deg, nmax)
+
+
+@njit(cache=True, nogil=True)
+def _element_geometry(nodes, elements, gw, nf, off):
+    """geo[e] = (b - a, L = |b - a|, a) of each element and Wt[e, off[n] + k] = gw[n, k] L,
+    the Gauss weights of the far pairs (the h = (1 - 0) L of the panel loop)."""
     ne = elements.shape[0]
+    geo = np.empty((ne, 5))
+    Wt = np.empty((ne, off[nf + 1]))
+    for e in range(ne):
+        a = nodes[elements[e, 0]]
+        b = nodes[elements[e, 1]]
+        geo[e, 0], geo[e, 1] = b[0] - a[0], b[1] - a[1]
+        geo[e, 2] = math.hypot(geo[e, 0], geo[e, 1])
+        geo[e, 3], geo[e, 4] = a[0], a[1]
+        for n in range(1, nf + 1):
+            for k in range(n):
+                Wt[e, off[n] + k] = gw[n, k] * geo[e, 2]
+    return geo, Wt
+
+
+@njit(cache=True, nogil=True)
+def _potential_rows(kid, kp, d, nout, pts, rows, nodes, elements, normals, degrees, kind,
+                    dofs, coef, gx, gw, gll_x, gll_b, nf, off, Y, FV, thr2, out):
+    """out[q] for q in ``rows``: the potential at pts[q] (NaN on Gamma), summed element
+    by element.  A far pair (the point at least one element length away: one panel, the
+    whole element) with an order n <= nf reads the Gauss points and density values of
+    :func:`_far_tables` and its order from :func:`_order_thresholds` (nf = 0: no
+    tables); the others are bisected (:func:`hpfebe.bem.integration.point_panels`), with
+    the order :func:`hpfebe.bem.integration._order` per panel.  The same sums in the same
+    order either way."""
     nmax = gx.shape[0] - 1
-    out = np.zeros((npts, nout))
-    pmax = degrees.max() + 1
-    for q in prange(npts):
-        phi = np.empty(pmax)
-        kv = np.empty(nout * d)
-        fv = np.empty(d)
-        stack = np.empty((128, 2))
-        panels = np.empty((128, 3))
+    ne = elements.shape[0]
+    phi = np.empty(degrees.max() + 1)
+    kv = np.empty(nout * d)
+    fv = np.empty(d)
+    acc = np.empty(nout)
+    stack = np.empty((128, 2))
+    panels = np.empty((128, 3))
+    scalar_sl = kid == POT_LAPLACE_SL and d == 1 and nout == 1
+    scalar_dl = kid == POT_LAPLACE_DL and d == 1 and nout == 1
+    geo, Wt = _element_geometry(nodes, elements, gw, nf, off)
+    for q in rows:
         x0, x1 = pts[q, 0], pts[q, 1]
-        acc = np.zeros(nout)
+        for r in range(nout):
+            acc[r] = 0.0
         onb = False
         for e in range(ne):
+            # scalars, no array views (their reference counting costs more than the
+            # rest of a far pair)
+            ux, uy, L, ax, ay = geo[e, 0], geo[e, 1], geo[e, 2], geo[e, 3], geo[e, 4]
+            p = degrees[e]
+            deg = p - 1 if kind == 0 else p
+            n = -1
+            if nf > 0:      # first step of point_panels: the distance to the element
+                t = min(1.0, max(0.0, ((x0 - ax) * ux + (x1 - ay) * uy) / (L * L)))
+                n = _far_order(x0 - ax - t * ux, x1 - ay - t * uy, L, deg, nmax, nf, thr2)
+            if 0 < n <= nf:
+                i0 = off[n]
+                n0, n1 = normals[e, 0], normals[e, 1]
+                if scalar_sl:                   # Laplace: the hot loops, inlined
+                    a0 = acc[0]
+                    for k in range(n):
+                        kv0 = _laplace_sl(x0 - Y[e, i0 + k, 0], x1 - Y[e, i0 + k, 1], kp)
+                        a0 += Wt[e, i0 + k] * (0.0 + kv0 * FV[e, i0 + k, 0])
+                    acc[0] = a0
+                    continue
+                if scalar_dl:
+                    a0 = acc[0]
+                    for k in range(n):
+                        kv0 = _laplace_dl(x0 - Y[e, i0 + k, 0], x1 - Y[e, i0 + k, 1], n0, n1)
+                        a0 += Wt[e, i0 + k] * (0.0 + kv0 * FV[e, i0 + k, 0])
+                    acc[0] = a0
+                    continue
+                for k in range(n):
+                    pot_kernel(kid, x0 - Y[e, i0 + k, 0], x1 - Y[e, i0 + k, 1], n0, n1, kp,
+                               kv)
+                    w = Wt[e, i0 + k]
+                    for r in range(nout):
+                        sacc = 0.0
+                        for c in range(d):
+                            sacc += kv[r * d + c] * FV[e, i0 + k, c]
+                        acc[r] += w * sacc
+                continue
             a = nodes[elements[e, 0]]
             b = nodes[elements[e, 1]]
-            ux, uy = b[0] - a[0], b[1] - a[1]
-            L = math.hypot(ux, uy)
-            p = degrees[e]
             nl = n_local(kind, p)
-            deg = p - 1 if kind == 0 else p
             npan = point_panels(x0, x1, a, b, 1e-13, stack, panels)
             if npan < 0:
                 onb = True      # x on Gamma: the potential is not defined there
@@ -165,6 +344,42 @@ def _potential(kid, kp, d, nout, pts, nodes, elements, normals, degrees, kind, d
                         acc[r] += w * sacc
         for r in range(nout):
             out[q, r] = math.nan if onb else acc[r]
+
+
+_NO_THRESHOLDS = np.zeros((0, 0))
+_NO_THRESHOLDS.setflags(write=False)
+MIN_TABLE_POINTS = 32       # fewer points: no far tables (building them costs more)
+MIN_PAIRS_PER_THREAD = 20000
+
+
+def _potential(kid, kp, d, nout, pts, mesh, space, coef, gx, gw, gll_x, gll_b):
+    """The values (n_points, nout) of :func:`_potential_rows` for all points, in chunks on
+    numba.get_num_threads() Python threads (nogil kernel, disjoint rows; no parfor to
+    compile)."""
+    npts, ne = pts.shape[0], mesh.n_elements
+    nmax = gx.shape[0] - 1
+    pmax = int(mesh.degrees.max())
+    nf = min(nmax, int(_order(2.0, pmax + 1, nmax)) + 1) if npts >= MIN_TABLE_POINTS else 0
+    if nf > 0:
+        off, Y, FV = _far_tables(mesh, space, coef, nf)
+        thr2 = _order_thresholds(pmax + 1, nf, nmax)
+    else:   # no tables; thr2 read-only like the cached one (one numba specialisation)
+        off, Y, FV, thr2 = (np.zeros(2, np.int64), np.zeros((0, 0, 2)),
+                            np.zeros((0, 0, d)), _NO_THRESHOLDS)
+    out = np.empty((npts, nout))
+    args = (int(kid), kp, d, nout, pts)
+    tail = (mesh.nodes, mesh.elements, np.ascontiguousarray(mesh.normals), mesh.degrees,
+            space.kind, space.elem_dofs, coef, gx, gw, gll_x, gll_b, nf, off, Y, FV, thr2,
+            out)
+    rows = np.arange(npts)
+    nt = min(numba.get_num_threads(), npts)
+    if nt <= 1 or npts * ne < MIN_PAIRS_PER_THREAD * nt:
+        _potential_rows(*args, rows, *tail)
+        return out
+    with ThreadPoolExecutor(max_workers=nt) as pool:
+        for f in [pool.submit(_potential_rows, *args, c, *tail)
+                  for c in np.array_split(rows, 4 * nt)]:
+            f.result()
     return out
 
 
@@ -189,9 +404,7 @@ def evaluate_potential(kid: int, kp, d: int, points, space, coeffs, nout: int | 
     gx, gw, _, _ = rules()
     gll_x, gll_b = gll_tables(P_MAX)
     kp = np.ascontiguousarray(np.asarray(kp, dtype=float).reshape(-1))
-    out = _potential(int(kid), kp, d, nout, pts, mesh.nodes, mesh.elements,
-                     np.ascontiguousarray(mesh.normals), mesh.degrees, space.kind,
-                     space.elem_dofs, coef, gx, gw, gll_x, gll_b)
+    out = _potential(int(kid), kp, d, nout, pts, mesh, space, coef, gx, gw, gll_x, gll_b)
     if not np.all(np.isfinite(out)):
         raise FloatingPointError("potential evaluated on the boundary Gamma")
     return out

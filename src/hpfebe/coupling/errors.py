@@ -33,6 +33,7 @@ import logging
 import time
 
 import numpy as np
+from scipy.spatial import cKDTree
 
 from ..analysis.norms import energy_error_dirichlet
 from ..quadrature import gauss_legendre, gauss_lobatto
@@ -47,14 +48,32 @@ def fe_errors(model: NitscheFEBE, sol: NitscheSolution) -> dict:
     return model.fe.errors(sol.U1, model.problem.u, model.problem.grad_u)
 
 
+LOCATE_TOL = 5e-11   # tol of BoundaryMesh.locate (relative to the mesh scale)
+
+
+def _near_boundary(mesh, pts: np.ndarray) -> np.ndarray:
+    """Indices of the points that may lie on the boundary mesh: those within half the
+    longest element length (+ the locate tolerance) of a mesh node.  A point farther
+    from every node is farther than the tolerance from every element (the nearest
+    point of an element lies within half its length of one of its ends), so
+    ``locate`` would return -1 for it: the others need not be located."""
+    ab = mesh.b - mesh.a
+    reach = 0.5 * float(np.sqrt(np.max(np.sum(ab ** 2, 1)))) + 4 * LOCATE_TOL * mesh.scale
+    d, _ = cKDTree(mesh.nodes[np.unique(mesh.elements)]).query(pts)
+    return np.flatnonzero(d <= reach * (1.0 + 1e-9))
+
+
 def boundary_values(model: NitscheFEBE, U2, pts) -> np.ndarray:
     """U2 at the points ``pts`` (n, 2) that lie on dOmega2 (the BE mesh), NaN at the
-    others (:meth:`hpfebe.geometry.BoundaryMesh.locate`)."""
-    elem, t = model.be_mesh.locate(pts)
-    out = np.full(len(elem), np.nan)
+    others (:meth:`hpfebe.geometry.BoundaryMesh.locate`, called for the points near a
+    mesh node only: :func:`_near_boundary`)."""
+    pts = np.asarray(pts, dtype=float)
+    out = np.full(len(pts), np.nan)
+    cand = _near_boundary(model.be_mesh, pts)
+    elem, t = model.be_mesh.locate(pts[cand], tol=LOCATE_TOL)
     on = elem >= 0
     if on.any():
-        out[on] = model.bem.V_space.evaluate(U2, elem[on], t[on])
+        out[cand[on]] = model.bem.V_space.evaluate(U2, elem[on], t[on])
     return out
 
 
@@ -109,64 +128,108 @@ def be_domain_errors(model: NitscheFEBE, sol: NitscheSolution, n_gauss: int | No
     interpolation error of the same mesh and nodes, for comparison).  Cells with a
     vertex at a singular point of the problem are integrated with a rule graded toward it
     (:func:`_graded_corner_rule`): a plain tensor rule there underestimates the H1 error
-    of Example 2 by 3.5 % at p = 7."""
-    if nodes not in ("gll", "equidistant"):
-        raise ValueError(f"nodes must be 'gll' or 'equidistant', got {nodes!r}")
-    pb, p = model.problem, model.p_be
-    dom = pb.omega2_domain(model.be_h_inv if h_inv is None else h_inv)
-    m = dom.mesh
-    x0, x1 = m.p[:, m.t[0]], m.p[:, m.t[2]]                 # lower left, upper right
-    hx, hy = x1[0] - x0[0], x1[1] - x0[1]
-    g = gauss_lobatto(p + 1)[0] if nodes == "gll" else np.linspace(-1.0, 1.0, p + 1)
-    s = 0.5 * (g + 1.0)
-    X = x0[0][:, None, None] + hx[:, None, None] * s[:, None][None]   # (nc, i, j)
-    Y = x0[1][:, None, None] + hy[:, None, None] * s[None, :][None]
-    X, Y = np.broadcast_arrays(X, Y)
-    pts_all = np.column_stack([X.ravel(), Y.ravel()])
-    key = np.round(pts_all / 1e-11).astype(np.int64)
-    uniq, inv = np.unique(key, axis=0, return_inverse=True)
-    pts = uniq * 1e-11
-    if interpolate_exact:
-        vals = pb.u(pts[:, 0], pts[:, 1])
-    else:
-        vals = be_solution_at(model, sol.U2, pts)
-    V = vals[inv.ravel()].reshape(X.shape)                          # (nc, p+1, p+1)
+    of Example 2 by 3.5 % at p = 7.  :func:`be_domain_errors_both` gives both variants
+    from one pass."""
+    which = ("exact",) if interpolate_exact else ("solution",)
+    setup = BEDomainSetup(model, n_gauss, h_inv, nodes)
+    return setup.errors(model, sol, which)[which[0]]
 
-    nq = n_gauss or p + 6
-    xq, wq = gauss_legendre(nq)
-    tensor = (np.repeat(xq, nq), np.tile(xq, nq), np.outer(wq, wq).ravel())
-    graded = _graded_corner_rule(nq)
-    # which corner (sx, sy in {-1, 1}) of each cell is a singular point, if any
-    corner = np.zeros((2, m.t.shape[1]), dtype=int)
-    for xs in pb.singular_points:
-        for sx in (-1, 1):
-            for sy in (-1, 1):
-                cx = (x0 if sx < 0 else x1)[0]
-                cy = (x0 if sy < 0 else x1)[1]
-                hit = np.hypot(cx - xs[0], cy - xs[1]) < 1e-12
-                corner[:, hit] = np.array([[sx], [sy]])
-    l2sq = h1sq = 0.0
-    for c in {tuple(v) for v in corner.T}:
-        cells = np.flatnonzero((corner[0] == c[0]) & (corner[1] == c[1]))
-        # the graded rule clusters at (-1, -1): reflect it to the corner (sx, sy)
-        xi, eta, w = tensor if c == (0, 0) else (-c[0] * graded[0], -c[1] * graded[1],
-                                                  graded[2])
-        Lx, Ly = _lagrange(g, xi), _lagrange(g, eta)
-        dLx, dLy = _lagrange(g, xi, derivative=True), _lagrange(g, eta, derivative=True)
-        Vc = V[cells]
-        uh = np.einsum("ai,cij,aj->ca", Lx, Vc, Ly)
-        ux = np.einsum("ai,cij,aj->ca", dLx, Vc, Ly) * (2.0 / hx[cells])[:, None]
-        uy = np.einsum("ai,cij,aj->ca", Lx, Vc, dLy) * (2.0 / hy[cells])[:, None]
-        qx = x0[0][cells, None] + hx[cells, None] * 0.5 * (xi + 1.0)[None]
-        qy = x0[1][cells, None] + hy[cells, None] * 0.5 * (eta + 1.0)[None]
-        wc = w[None] * (0.25 * hx[cells] * hy[cells])[:, None]
-        gx, gy = pb.grad_u(qx, qy)
-        l2sq += float((wc * (uh - pb.u(qx, qy)) ** 2).sum())
-        h1sq += float((wc * ((ux - gx) ** 2 + (uy - gy) ** 2)).sum())
-    l2, h1 = np.sqrt(l2sq), np.sqrt(h1sq)
-    if not (np.isfinite(l2) and np.isfinite(h1)):
-        raise FloatingPointError("BE-part domain error is not finite")
-    return {"l2": float(l2), "h1": float(h1)}
+
+def be_domain_errors_both(model: NitscheFEBE, sol: NitscheSolution,
+                          n_gauss: int | None = None, h_inv: float | None = None,
+                          nodes: str = "equidistant", setup=None) -> tuple[dict, dict]:
+    """(be_domain_errors(...), be_domain_errors(..., interpolate_exact=True)), the
+    same numbers, with the mesh, the nodes, the quadrature and the exact solution at
+    the quadrature points computed once for both (``setup``: a :class:`BEDomainSetup`
+    of ``model`` to reuse, e.g. for several lambda_Nit)."""
+    setup = setup or BEDomainSetup(model, n_gauss, h_inv, nodes)
+    out = setup.errors(model, sol, ("solution", "exact"))
+    return out["solution"], out["exact"]
+
+
+class BEDomainSetup:
+    """What the BE-part domain errors of one model need besides the solution: the
+    rectangle mesh of Omega2, the interpolation nodes (unique points and the map from
+    the cells' nodes to them), and per group of cells (tensor rule, or the graded rule
+    at a singular corner) the Lagrange bases at the quadrature points, the weights and
+    the exact u and grad u there (see :func:`be_domain_errors`)."""
+
+    def __init__(self, model: NitscheFEBE, n_gauss: int | None = None,
+                 h_inv: float | None = None, nodes: str = "equidistant"):
+        if nodes not in ("gll", "equidistant"):
+            raise ValueError(f"nodes must be 'gll' or 'equidistant', got {nodes!r}")
+        pb, p = model.problem, model.p_be
+        self.key = (id(model), n_gauss, h_inv, nodes)
+        m = pb.omega2_domain(model.be_h_inv if h_inv is None else h_inv).mesh
+        x0, x1 = m.p[:, m.t[0]], m.p[:, m.t[2]]                 # lower left, upper right
+        hx, hy = x1[0] - x0[0], x1[1] - x0[1]
+        g = gauss_lobatto(p + 1)[0] if nodes == "gll" else np.linspace(-1.0, 1.0, p + 1)
+        s = 0.5 * (g + 1.0)
+        X = x0[0][:, None, None] + hx[:, None, None] * s[:, None][None]   # (nc, i, j)
+        Y = x0[1][:, None, None] + hy[:, None, None] * s[None, :][None]
+        X, Y = np.broadcast_arrays(X, Y)
+        pts_all = np.column_stack([X.ravel(), Y.ravel()])
+        key = np.round(pts_all / 1e-11).astype(np.int64)
+        uniq, self.inv = np.unique(key, axis=0, return_inverse=True)
+        self.pts, self.shape = uniq * 1e-11, X.shape
+        self._exact_at_nodes = pb.u(self.pts[:, 0], self.pts[:, 1])
+
+        nq = n_gauss or p + 6
+        xq, wq = gauss_legendre(nq)
+        tensor = (np.repeat(xq, nq), np.tile(xq, nq), np.outer(wq, wq).ravel())
+        graded = _graded_corner_rule(nq)
+        # which corner (sx, sy in {-1, 1}) of each cell is a singular point, if any
+        corner = np.zeros((2, m.t.shape[1]), dtype=int)
+        for xs in pb.singular_points:
+            for sx in (-1, 1):
+                for sy in (-1, 1):
+                    cx = (x0 if sx < 0 else x1)[0]
+                    cy = (x0 if sy < 0 else x1)[1]
+                    hit = np.hypot(cx - xs[0], cy - xs[1]) < 1e-12
+                    corner[:, hit] = np.array([[sx], [sy]])
+        self.groups = []
+        for c in {tuple(v) for v in corner.T}:
+            cells = np.flatnonzero((corner[0] == c[0]) & (corner[1] == c[1]))
+            # the graded rule clusters at (-1, -1): reflect it to the corner (sx, sy)
+            xi, eta, w = tensor if c == (0, 0) else (-c[0] * graded[0], -c[1] * graded[1],
+                                                      graded[2])
+            qx = x0[0][cells, None] + hx[cells, None] * 0.5 * (xi + 1.0)[None]
+            qy = x0[1][cells, None] + hy[cells, None] * 0.5 * (eta + 1.0)[None]
+            gx, gy = pb.grad_u(qx, qy)
+            self.groups.append(dict(
+                cells=cells, Lx=_lagrange(g, xi), Ly=_lagrange(g, eta),
+                dLx=_lagrange(g, xi, derivative=True), dLy=_lagrange(g, eta, derivative=True),
+                sx=(2.0 / hx[cells])[:, None], sy=(2.0 / hy[cells])[:, None],
+                wc=w[None] * (0.25 * hx[cells] * hy[cells])[:, None],
+                u=pb.u(qx, qy), gx=gx, gy=gy))
+
+    def errors(self, model: NitscheFEBE, sol: NitscheSolution, which) -> dict:
+        """{w: {'l2', 'h1'}} for w in ``which``: "solution" (interpolant of the BE
+        solution of ``sol``) and/or "exact" (interpolant of the exact u)."""
+        if self.key[0] != id(model):
+            raise ValueError("setup belongs to another model")
+        V = {}                                                      # (nc, p+1, p+1) each
+        for w in which:
+            vals = self._exact_at_nodes if w == "exact" else \
+                be_solution_at(model, sol.U2, self.pts)
+            V[w] = vals[self.inv.ravel()].reshape(self.shape)
+        l2sq, h1sq = dict.fromkeys(which, 0.0), dict.fromkeys(which, 0.0)
+        for gr in self.groups:
+            for w in which:
+                Vc = V[w][gr["cells"]]
+                uh = np.einsum("ai,cij,aj->ca", gr["Lx"], Vc, gr["Ly"])
+                ux = np.einsum("ai,cij,aj->ca", gr["dLx"], Vc, gr["Ly"]) * gr["sx"]
+                uy = np.einsum("ai,cij,aj->ca", gr["Lx"], Vc, gr["dLy"]) * gr["sy"]
+                l2sq[w] += float((gr["wc"] * (uh - gr["u"]) ** 2).sum())
+                h1sq[w] += float((gr["wc"] * ((ux - gr["gx"]) ** 2
+                                              + (uy - gr["gy"]) ** 2)).sum())
+        out = {}
+        for w in which:
+            l2, h1 = np.sqrt(l2sq[w]), np.sqrt(h1sq[w])
+            if not (np.isfinite(l2) and np.isfinite(h1)):
+                raise FloatingPointError("BE-part domain error is not finite")
+            out[w] = {"l2": float(l2), "h1": float(h1)}
+        return out
 
 
 def be_trace_energy_error(model: NitscheFEBE, sol: NitscheSolution, extra: int = 4) -> float:
@@ -196,11 +259,17 @@ def lambda_sweep(problem: InterfaceProblem | str, fe_h_inv: float, be_h_inv: flo
     model = NitscheFEBE(pb, fe_h_inv, be_h_inv, int(p), alpha=alpha, h_def=h_def)
     t_asm = time.perf_counter() - t0
     rows = []
+    setup = None                    # BE-part error geometry, shared by the lambda_Nit
     for lambda_nit in lambdas:
         t1 = time.perf_counter()
         sol = model.solve(lambda_nit)
         t_solve = time.perf_counter() - t1
-        fe, be = fe_errors(model, sol), be_domain_errors(model, sol)
+        fe = fe_errors(model, sol)
+        setup = setup or BEDomainSetup(model)
+        if companions:
+            be, be_exact = be_domain_errors_both(model, sol, setup=setup)
+        else:
+            be = setup.errors(model, sol, ("solution",))["solution"]
         row = dict(lambda_nit=lambda_nit, p=int(p), fe_h_inv=fe_h_inv, be_h_inv=be_h_inv,
                    n_fe=model.n1, n_be=model.n2, dof=model.ndof, fe_l2=fe["l2"],
                    fe_h1=fe["h1"], be_l2=be["l2"], be_h1=be["h1"], assembly_s=t_asm,
@@ -208,7 +277,7 @@ def lambda_sweep(problem: InterfaceProblem | str, fe_h_inv: float, be_h_inv: flo
                    residual=sol.info["residual"])
         if companions:
             row["be_energy"] = be_trace_energy_error(model, sol)
-            row["be_h1_interp"] = be_domain_errors(model, sol, interpolate_exact=True)["h1"]
+            row["be_h1_interp"] = be_exact["h1"]
         rows.append(row)
         log.info("%s p=%d FE 1/%g BE 1/%g lambda_Nit=%g dof=%d: FE %.3e %.3e BE %.3e %.3e "
                  "(%.2f s + %.2f s)", pb.name, p, fe_h_inv, be_h_inv, lambda_nit,

@@ -195,9 +195,10 @@ class NitscheFEBE:
         K22 = self.S + lambda_nit * self.P22
         return K11, K12, K22
 
-    def matrix(self, lambda_nit: float) -> sp.csr_matrix:
-        """The whole system matrix (sparse, BE block stored densely) - for checks."""
-        K11, K12, K22 = self.blocks(lambda_nit)
+    def matrix(self, lambda_nit: float, blocks=None) -> sp.csr_matrix:
+        """The whole system matrix (sparse, BE block stored densely) - for checks;
+        ``blocks``: ``self.blocks(lambda_nit)`` if already at hand."""
+        K11, K12, K22 = self.blocks(lambda_nit) if blocks is None else blocks
         return sp.bmat([[K11, K12], [K12.T, sp.csr_matrix(K22)]]).tocsr()
 
     @staticmethod
@@ -212,10 +213,10 @@ class NitscheFEBE:
         """Solve (2.3) by one sparse LU of the coupled system (module doc)."""
         t0 = time.perf_counter()
         lambda_nit = self._check_lambda(lambda_nit)
-        K11, K12, K22 = self.blocks(lambda_nit)
+        K11, K12, K22 = blocks = self.blocks(lambda_nit)
         K21 = K12.T.tocsr()
         try:
-            lu = spla.splu(self.matrix(lambda_nit).tocsc())
+            lu = spla.splu(self.matrix(lambda_nit, blocks).tocsc())
         except RuntimeError as exc:
             raise np.linalg.LinAlgError(f"coupled system singular for lambda_Nit="
                                         f"{lambda_nit}: {exc}") from exc

@@ -47,6 +47,39 @@ def quad_element(p: int):
         log.setLevel(level)
 
 
+class _MemoInvDF:
+    """The mesh's skfem mapping, remembering invDF(X, tind) of the last (X, tind) pair
+    (by identity): a CellBasis evaluates all its basis functions at one X and tind, and
+    each gbasis call would compute the same inverse Jacobians again (most of the time
+    of building a Q_p basis for p >= 2).  The same arrays, so the same numbers."""
+
+    def __init__(self, mapping):
+        self._mapping = mapping
+        self._last = None
+
+    def __getattr__(self, name):
+        return getattr(self._mapping, name)
+
+    def invDF(self, X, tind=None):
+        last = self._last
+        if last is not None and last[0] is X and last[1] is tind:
+            return last[2]
+        out = self._mapping.invDF(X, tind)
+        self._last = (X, tind, out)
+        return out
+
+    def forget(self):
+        self._last = None
+
+
+def _basis(mesh, element, intorder: int) -> Basis:
+    """skfem ``Basis(mesh, element, intorder=...)`` built with :class:`_MemoInvDF`."""
+    mapping = _MemoInvDF(mesh._mapping())
+    basis = Basis(mesh, element, mapping=mapping, intorder=intorder)
+    mapping.forget()
+    return basis
+
+
 class PoissonFE:
     """Q_p finite elements on an :class:`FEDomain` (or a labelled rectangle ``MeshQuad``)
     with u = 0 on the facets ``dirichlet``.
@@ -65,7 +98,7 @@ class PoissonFE:
         self.p = int(p)
         self.element = quad_element(p)
         # Q_p x Q_p products on rectangles are polynomials of degree 2p per direction
-        self.basis = Basis(domain.mesh, self.element, intorder=2 * self.p + 1)
+        self.basis = _basis(domain.mesh, self.element, 2 * self.p + 1)
         self.ndof = self.basis.N
         fixed = [domain.facets[lab] for lab in dirichlet if lab in domain.facets]
         fixed = np.concatenate(fixed) if fixed else np.zeros(0, dtype=np.int64)
@@ -133,6 +166,8 @@ class PoissonFE:
             val[k] = np.asarray(f)[:, 0]
             gx[k] = f.grad[0][:, 0]
             gy[k] = f.grad[1][:, 0]
+        if isinstance(mapping, _MemoInvDF):
+            mapping.forget()
         rows = np.tile(np.arange(pts.shape[0]), nb)
         cols = self.basis.element_dofs[:, cells].ravel()
         shape = (pts.shape[0], self.ndof)
@@ -146,8 +181,11 @@ class PoissonFE:
         U = np.asarray(U, dtype=float)
         if U.shape != (self.ndof,):
             raise ValueError(f"U must have {self.ndof} entries, got {U.shape}")
-        basis = Basis(self.domain.mesh, self.element,
-                      intorder=intorder or 2 * self.p + 6)
+        order = intorder or 2 * self.p + 6
+        cache = self.__dict__.setdefault("_error_bases", {})   # one per order (lambda sweeps)
+        if order not in cache:
+            cache[order] = _basis(self.domain.mesh, self.element, order)
+        basis = cache[order]
 
         @Functional
         def e_l2(w):
