@@ -194,10 +194,11 @@ class Params:
                              f"{self.conv_n1!r}")
 
 
-def _problem(prm: Params, n1, n2, p1, p2):
+def _problem(prm: Params, n1, n2, p1, p2, bem_cache: dict | None = None):
     return model_problem(n1=n1, n2=n2, p1=p1, p2=p2, E=prm.E, nu=prm.nu, F=prm.F,
                          u_top=(0.0, prm.u_top), radius=prm.radius, plane=prm.plane,
-                         geometry=prm.geometry, side_depth=prm.side_depth)
+                         geometry=prm.geometry, side_depth=prm.side_depth,
+                         bem_cache=bem_cache)
 
 
 def _solve(pr, prm: Params, wD, wN, friction="tresca", transfer="functional"):
@@ -349,11 +350,11 @@ def figure_4_17(prm: Params, pr, best) -> ArtefactResult:
 
 # --------------------------------------------------------------------------- fig 4.18
 def convergence_sweep(prm: Params) -> pd.DataFrame:
-    rows = []
+    rows, bems = [], {}              # each body assembled once (shared by degree pairs)
     for p1, p2 in progress(prm.conv_degrees, desc="figure_4_18"):
         for n1 in prm.conv_n1:
             t = time.perf_counter()
-            pr = _problem(prm, n1, 3 * n1 // 4, p1, p2)
+            pr = _problem(prm, n1, 3 * n1 // 4, p1, p2, bems)
             sol = _solve(pr, prm, *prm.conv_omega)
             rows.append(dict(p1=p1, p2=p2, n1=n1, n2=3 * n1 // 4, h1=2.0 / n1, dof=_dof(pr),
                              norm_W=pr.norm_W(sol.U1, sol.U2),

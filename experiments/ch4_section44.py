@@ -96,7 +96,9 @@ CHOICES = (
     "same formulation) checks the mesh: measured penetration 1.553e-6, 3.035e-6, "
     "5.902e-6, 1.135e-5 against 1.554e-6, 3.041e-6, 5.931e-6, 1.141e-5 on 61 x 31 "
     "(within 0.6 %, slopes 0.957 and 0.959; about 10 s): the factor ~2 to Table 4.3 is "
-    "no discretisation effect of the work piece.",
+    "no discretisation effect of the work piece. The two-pass claim: one extra run at "
+    "twice the largest factor (two_pass_check) compares ours at 2 x factor with the "
+    "thesis at factor (a penalty counted twice, each body the slave once).",
     "Figure 4.22 shows the run with 1/eps_n = figure_factor x E_m (the thesis does not say "
     "which); the BE stamp's interior displacement by the representation formula on a grid "
     "of cell size h_stamp/2. u_x, u_y colour ranges are nodal min/max.",
@@ -125,6 +127,10 @@ class Params:
     slope_tol: float = 0.15            # penetration ~ eps^1: |slope - 1| <= slope_tol
     range_tol: float = 0.1             # colorbar ranges within 10 % of the published span
     pen_factor: float = 2.0            # penetration norms within a factor 2
+    # the two-pass reading of Table 4.3: ours at 2 x factor against the thesis at factor
+    # (one extra run at twice the largest factor), within two_pass_tol
+    two_pass_check: bool = True
+    two_pass_tol: float = 0.1
     h_work_fine: float = 0.0           # > 0: the sweep again on this work piece mesh
     # penalty work piece: "mortar" = the mortar runs' work_cells (the thesis's 1984 nodes
     # in both methods), "h_work" = uniform cells of size h_work; its Q1 formulation
@@ -298,6 +304,54 @@ def pressure_claim(prm: Params, tab: pd.DataFrame, published: pd.DataFrame) -> C
                  "shows the norms on a finer work piece mesh.")
 
 
+def two_pass_claim(prm: Params, runs: dict, published: pd.DataFrame) -> Claim:
+    """(analysis) Table 4.3's norms against a two-pass (symmetric master-slave) penalty:
+    with every other boundary part a possible contact boundary (Section 4.4), each body
+    is the slave against the other once, the penalty force counts twice and acts like
+    2/eps_n.  Ours at 2 x factor (``runs``: factor -> Run, the extra one at twice the
+    largest factor included) against the thesis at factor, within two_pass_tol; and the
+    Cauchy-Schwarz bound of a single pass, F = (1/eps_n) int pen ds <= (1/eps_n)
+    ||pen||_L2 |supp|^(1/2), i.e. ||pen||_L2 >= eps_n F / |supp|^(1/2) >= eps_n F (the
+    support lies on the stamp's bottom, |supp| <= 1), with our contact force F."""
+    ok = {f: r for f, r in runs.items() if r.result.converged and r.peak is not None}
+    ratios, parts = [], []
+    for f, pub in zip(published.inv_eps_n_over_E, published.penetration_l2):
+        items, r2, r1 = [], ok.get(2.0 * f), ok.get(f)
+        if r2 is not None:
+            ratios.append(r2.penetration_l2 / pub)
+            items.append(f"ours at {2 * f:g}E {r2.penetration_l2:.3e} / thesis {pub:.2e} "
+                         f"= {ratios[-1]:.3f}")
+        if r1 is not None:
+            c = r1.peak.result
+            force, supp = c.total_forces()[0], float(c.weights[c.g_n < 0].sum())
+            low = force / (f * prm.E)                  # eps_n F, |supp| <= 1
+            tight = f"; {low / np.sqrt(supp):.3e} with our support {supp:.3f}" \
+                if supp > 0 else ""
+            items.append(f"single-pass bound eps_n F = {low:.3e} (F = {force:.3f}{tight}), "
+                         f"thesis / bound {pub / low:.2f}")
+        if items:
+            parts.append(f"{f:g}E: " + ", ".join(items))
+    fig, pub_uy = ok.get(prm.figure_factor), PUB_UY["stamp"][1]
+    uy = f"thesis {pub_uy:.3e}"
+    if fig is not None:
+        ours_uy = float(fig.peak.u_stamp[1::2].max())
+        uy = (f"ours {ours_uy:.3e} at {prm.figure_factor:g}E, {uy}: the thesis's stamp is "
+              + ("not compressed less, so its force is not smaller" if pub_uy >= ours_uy
+                 else f"compressed {1 - pub_uy / ours_uy:.0%} less"))
+    tol = prm.two_pass_tol
+    holds = bool(len(ratios) == len(published) and
+                 all(abs(q - 1.0) <= tol for q in ratios)) if ratios else None
+    return Claim(
+        "(analysis) Table 4.3's penetration norms are those of a penalty of stiffness "
+        "2/eps_n (a two-pass, symmetric master-slave treatment, each body's boundary a "
+        "slave against the other - Section 4.4: every other boundary part is a possible "
+        f"contact boundary): ours at 2 x factor within {tol:.0%} of the thesis at factor",
+        holds, "; ".join(parts) + ". A single pass cannot print a norm below eps_n F "
+        "with the force F that the stamp's compression needs (its largest u_y, Figure "
+        f"4.22: {uy}); a doubled penalty force halves that bound. The thesis prints 1-2 "
+        "digits (0.8e-6: +-6 %).")
+
+
 def newton_claim(tab: pd.DataFrame, published: pd.DataFrame) -> Claim:
     m = tab.merge(published, on="inv_eps_n_over_E", suffixes=("", "_pub"))
     ev = "; ".join(f"{f:g}E: ours {a} ({n} increments), thesis {b}" for f, a, n, b in zip(
@@ -325,13 +379,19 @@ def trend_claims(tab: pd.DataFrame) -> list[Claim]:
 
 # --------------------------------------------------------------------------- figure
 def body_fields(prm: Params, r: Run) -> dict:
-    """Nodal points, cells and displacement of both bodies at full lift."""
-    fe, s = r.fe, r.peak
+    """Nodal points, cells and displacement of both bodies at full lift (the BE stamp's
+    interior by the representation formula: computed once per run and grid, kept on the
+    run - Figure 4.22, the comparison and its variants ask for the same run's fields)."""
     nx = max(1, int(round((STAMP[1] - STAMP[0]) / prm.h_stamp * 2)))
     ny = max(1, int(round((STAMP[3] - STAMP[2]) / prm.h_stamp * 2)))
-    ps, us, cs = stamp_interior(s.stamp, s.u_stamp, nx, ny)
-    return {"work": (fe.mesh.p.T, fe.mesh.t.T, fe.elastic.nodal_displacement(s.u_work).T),
-            "stamp": (ps, np.asarray(cs), us)}
+    cache = r.__dict__.setdefault("_body_fields", {})
+    if (nx, ny) not in cache:
+        fe, s = r.fe, r.peak
+        ps, us, cs = stamp_interior(s.stamp, s.u_stamp, nx, ny)
+        cache[(nx, ny)] = {"work": (fe.mesh.p.T, fe.mesh.t.T,
+                                    fe.elastic.nodal_displacement(s.u_work).T),
+                           "stamp": (ps, np.asarray(cs), us)}
+    return cache[(nx, ny)]
 
 
 def _ranges(bodies: dict, dev: np.ndarray, pub_ux: dict, pub_uy: dict,
@@ -1184,6 +1244,10 @@ def penalty_artefacts(prm: Params):
     t0 = time.perf_counter()
     runs = {f: run_penalty(prm, f) for f in progress(prm.eps_n_factors, desc="penalty")}
     tab = penalty_table(prm, runs)
+    doubled = dict(runs)                 # the two-pass reading: 2 x factor (one extra run)
+    if prm.two_pass_check:
+        doubled.update({2.0 * f: run_penalty(prm, 2.0 * f) for f in prm.eps_n_factors
+                        if 2.0 * f not in runs})
     fine = None
     if prm.h_work_fine > 0:
         pf = _fine(prm)
@@ -1197,14 +1261,17 @@ def penalty_artefacts(prm: Params):
                 allow_nan_columns=["penetration_l2", "max_dev_sigma", "contact_force",
                                    "p_n_l2"],
                 slope_table_mesh=penetration_slope(tab),
-                slope_fine_mesh=None if fine is None else penetration_slope(fine))
+                slope_fine_mesh=None if fine is None else penetration_slope(fine),
+                two_pass_penetration={f"{f:g}": r.penetration_l2 for f, r in doubled.items()
+                                      if f not in runs and r.peak is not None})
     path = Path(__file__).resolve().parents[1] / "report" / "published" / PUBLISHED
     published = pd.read_csv(path, comment="#") if path.exists() else _published_fallback()
     t43 = ArtefactResult(
         "table_4_3", tab, published=PUBLISHED, keys=("inv_eps_n_over_E", "inv_eps_t_over_E"),
         tolerances={"penetration_l2": ("factor", prm.pen_factor)},
         claims=[*trend_claims(tab), slope_claim(prm, tab, fine),
-                pressure_claim(prm, tab, published), newton_claim(tab, published)],
+                pressure_claim(prm, tab, published), two_pass_claim(prm, doubled, published),
+                newton_claim(tab, published)],
         notes=notes, meta=meta)
     r = runs[prm.figure_factor]
     if r.peak is None:

@@ -110,3 +110,37 @@ def test_stamp_condensed_once(scene, monkeypatch):
     for pair in ((0.5, 0.7), (0.7, 0.5)):
         assert scene.dtn(*pair).info.converged
     assert scene.body1 is body1
+
+
+def test_spd_band_solve():
+    """Banded Cholesky of the Newton step of step 2: the SuperLU solution to round-off;
+    None (SuperLU fallback) for a non-symmetric, an indefinite or a wide-band matrix."""
+    import scipy.sparse as sp
+    import scipy.sparse.linalg as spla
+
+    from hpfebe.contact.mortar_fe import spd_band_solve
+
+    n = 200
+    A = sp.diags([-1.0, -0.5, 4.0, -0.5, -1.0], [-2, -1, 0, 1, 2], shape=(n, n)).tocsr()
+    b = np.sin(np.arange(n))
+    x = spd_band_solve(A, b)
+    ref = spla.spsolve(A.tocsc(), b)
+    assert np.abs(x - ref).max() <= 1e-13 * np.abs(ref).max()
+    assert spd_band_solve(A + sp.diags([0.1], [1], shape=(n, n)), b) is None
+    assert spd_band_solve(-A, b) is None
+    wide = A + sp.coo_matrix(([1e-3, 1e-3], ([0, n - 1], [n - 1, 0])), shape=(n, n))
+    assert spd_band_solve(wide, b) is None
+
+
+def test_dtn_newton_uses_band_solve(scene, monkeypatch):
+    """Step 2 solves its Newton systems by the banded Cholesky (no SuperLU call)."""
+    import scipy.sparse.linalg as spla
+
+    def fail(*a, **k):
+        raise AssertionError("spsolve called")
+
+    monkeypatch.setattr(spla, "spsolve", fail)
+    P = np.tile([0.0, 5.0], scene.c2.size // 2)       # a yield-level push on Gamma^2_C
+    u2, info = scene.neumann(P)
+    assert info.converged and info.iterations > 0, info.reason
+    assert scene.work_fields(u2)["eps_p_norm"].max() > 0       # plastic: a real Newton

@@ -151,3 +151,75 @@ def test_semismooth_newton_agrees(coarse, friction):
     if friction == "tresca":
         d = pr.dtn(0.7, 0.5, tol=1e-10, tol_U=1e-9, max_uzawa=20000)
         assert np.abs(n.U1 - d.U1).max() <= 1e-7 * np.abs(d.U1).max()
+
+
+def _numpy_uzawa(pr, Q, rho, bound, tol, max_iter):
+    """Algorithm 4.4 in its numpy formulation (projected_cg + the clip), by fixed_point."""
+    from hpfebe.contact.mortar import projected_cg
+    from hpfebe.nonlinear import fixed_point
+
+    nc = pr.nc
+    F = pr.F if bound is None else bound
+    Fw, upper = pr._qp_data(Q, bound)
+    _, Qt = pr.frame(Q)
+    st = {"x": None}
+
+    def update(lam):
+        rhs = np.array(pr.b, dtype=float)
+        rhs[nc:] -= Fw * lam
+        x, inner = projected_cg(pr.A, rhs, upper, st["x"], tol=1e-11,
+                                max_iter=20 * rhs.size + 100)
+        st["x"] = x
+        return np.minimum(np.maximum(lam + rho * F * (x[nc:] - Qt), -1.0), 1.0), inner
+
+    return fixed_point(update, np.zeros(nc), tol, max_iter, norm=2)
+
+
+def test_compiled_uzawa_step_is_the_numpy_iteration(sticky):
+    """uzawa's compiled iteration (_uzawa_step) gives bit for bit the numpy formulation
+    of Algorithm 4.4: projected CG on b - (0, F w lambda), then the clip to [-1, 1]."""
+    pr, nc = sticky, sticky.nc
+    rng = np.random.default_rng(3)
+    Q = 1e-4 * rng.standard_normal(2 * nc)
+    rho = pr.rho_step(1.0, True)
+    for bound in (None, np.abs(rng.standard_normal(nc)) * pr.F):
+        _, lam, info = pr.uzawa(Q, rho=rho, tol=1e-9, max_iter=300, bound=bound)
+        lam_ref, info_ref = _numpy_uzawa(pr, Q, rho, bound, 1e-9, 300)
+        assert info.iterations == info_ref.iterations and info.converged == info_ref.converged
+        assert np.array_equal(lam, lam_ref)
+        assert info.residuals == info_ref.residuals and info.steps == []
+        assert info.counts["qp_solves"] == info.iterations == len(info_ref.steps)
+        assert info.counts["cg_steps"] == sum(s.counts["cg_steps"] for s in info_ref.steps)
+    with pytest.raises(ValueError, match="lam0"):
+        pr.uzawa(Q, rho=rho, lam0=np.zeros(nc + 1))
+    with pytest.raises(ValueError, match="x0"):
+        pr.uzawa(Q, rho=rho, x0=np.zeros(3))
+
+
+def test_condensed_solve_and_adjoint_match_scipy(coarse):
+    """CondensedBody.solve (LAPACK potrs directly) and MortarProjection.adjoint (B^T
+    formed once) give the numbers of scipy's cho_solve / B.T @ ... bit for bit."""
+    import scipy.linalg as sla
+
+    pr = coarse
+    b1 = pr.body1
+    load = np.linspace(-1.0, 1.0, b1.b.size)
+    assert np.array_equal(b1.solve(load), sla.cho_solve(sla.cho_factor(b1.A), b1.b + load))
+    with pytest.raises(ValueError, match="load_c"):
+        b1.solve(np.full(b1.b.size, np.nan))
+    m = pr.mortar
+    r = np.linspace(0.5, 2.0, 2 * m.dofs1.size)
+    ref = (m.B.T @ m._lu.solve(r.reshape(-1, 2), trans="T")).ravel()
+    assert np.array_equal(m.adjoint(r), ref)
+    assert np.array_equal(m.adjoint(r), ref)           # the cached transpose
+
+
+def test_model_problem_bem_cache():
+    """A shared bem_cache reuses body 2 across body-1 degrees, with the same numbers as
+    a fresh set-up."""
+    cache = {}
+    a = model_problem(n1=4, n2=3, p1=1, p2=1, bem_cache=cache)
+    b = model_problem(n1=4, n2=3, p1=2, p2=1, bem_cache=cache)
+    assert b.bem2 is a.bem2 and b.bem1 is not a.bem1 and len(cache) == 3
+    fresh = model_problem(n1=4, n2=3, p1=2, p2=1)
+    assert np.array_equal(b.A, fresh.A) and np.array_equal(b.body2.A, fresh.body2.A)

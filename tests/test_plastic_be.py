@@ -354,3 +354,16 @@ def test_node_displacements_and_cell_lookup():
         rectangle_work_piece((-2, 2, -3, -1), 4, 2, MAT, cells="hex")
     with pytest.raises(ValueError, match="cell_rows"):
         rectangle_work_piece((-2, 2, -3, -1), 4, 2, MAT, cell_rows=3)
+
+
+def test_times_blocks_is_the_batched_matmul_bitwise():
+    """A @ blockdiag(D) of the cell-strain Jacobian: the loop kernel gives the numbers
+    of np.matmul's small-matrix products bit for bit (a strided column selection too)."""
+    from hpfebe.plastic_be import _times_blocks
+    rng = np.random.default_rng(4)
+    M = rng.standard_normal((90, 120))
+    p3 = np.sort(rng.choice(120, 60, replace=False))
+    D = rng.standard_normal((20, 3, 3))
+    A = M[:, p3]
+    ref = np.matmul(np.ascontiguousarray(A).reshape(90, 20, 1, 3), D[None]).reshape(90, 60)
+    np.testing.assert_array_equal(_times_blocks(A, D), ref)

@@ -8,7 +8,8 @@ import math
 import numpy as np
 import pytest
 
-from hpfebe.fem.plasticity import (J2Material, J2State, dev, return_map, tensor_norm)
+from hpfebe.fem.plasticity import (J2Material, J2State, consistent_tangent, dev, return_map,
+                                  tensor_norm)
 
 MAT = dict(E=266926.0, nu=0.29, sigma_Y=4.0, H=450.0)
 
@@ -186,3 +187,21 @@ def test_bad_return_map_input():
         return_map(mat, np.zeros((2, 3, 3)), J2State.zeros(3))
     with pytest.raises(ValueError, match="n"):
         J2State.zeros(-1)
+
+
+def test_consistent_tangent_at_a_subset_is_the_full_tangent_bitwise():
+    """consistent_tangent at some points = those rows of return_map's tangent, bit for
+    bit; the elastic points carry the elastic tangent exactly."""
+    mat = J2Material(266926.0, 0.29, 4.0, 450.0, 0.5)
+    rng = np.random.default_rng(7)
+    e = rng.normal(scale=3e-5, size=(40, 2, 2))
+    rm = return_map(mat, e + np.swapaxes(e, 1, 2), J2State.zeros(40), "algorithmic")
+    assert 0 < rm.plastic.sum() < 40
+    pts = np.flatnonzero(rm.plastic)[::2]
+    np.testing.assert_array_equal(consistent_tangent(mat, rm, "algorithmic", pts),
+                                  rm.tangent[pts])
+    el = np.flatnonzero(~rm.plastic)
+    np.testing.assert_array_equal(rm.tangent[el],
+                                  np.broadcast_to(mat.elastic_tangent(), (el.size,) + (3,) * 4))
+    with pytest.raises(ValueError, match="tangent"):
+        consistent_tangent(mat, rm, "secant")

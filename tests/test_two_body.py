@@ -626,3 +626,47 @@ def test_figure_4_13_coarse_with_boundary_elements(combo):
     ty = pr.dofs_on("slave", "top", 1)
     force = np.sum(res.weights * (res.p_n * pr.normals[:, 1] - res.t_t * pr.tangents[:, 1]))
     assert force > 0 and abs(np.sum(fint[ty]) + force) <= 1e-8 * force
+
+
+def test_plastic_tangent_is_lazy_and_lu_orderings_reuse():
+    """A plastic body's tangent is assembled only when the Newton step asks for it;
+    the reused column ordering of a sparsity pattern gives the factorisation SuperLU's
+    default gives, bit for bit; lu_ordering="MMD_AT_PLUS_A" solves the same problem
+    (other round-off)."""
+    import scipy.sparse.linalg as spla
+    from hpfebe.contact import loading
+    from hpfebe.fem.plastic_body import ElastoPlasticFE
+    from hpfebe.fem.plasticity import J2Material
+
+    def problem():
+        stamp = ElasticBody(rectangle_mesh(-0.5, 0.5, 0, 1, 3, 3, "quad"), E, NU)
+        work = ElastoPlasticFE(rectangle_mesh(-1, 1, -1, 0, 6, 3, "quad"),
+                               J2Material(E, NU, 4.0, 450.0, 1.0))
+        pr = TwoBodyContact(stamp, work, "bottom", "top", eps_n=1 / (10 * E),
+                            eps_t=1 / (5 * E), mu_f=0.2)
+        fixed = np.concatenate([pr.dofs_on("slave", "top"), pr.dofs_on("master", "bottom")])
+        vals = np.where(np.isin(fixed, pr.dofs_on("master", "bottom", 1)), 2e-3, 0.0)
+        return pr, fixed, vals
+
+    pr, fixed, vals = problem()
+    _, cs = pr.internal_force(np.zeros(pr.ndofs), np.zeros(len(pr.points)))
+    assert "K_body" not in cs and cs["K_body"].shape == (pr.ndofs, pr.ndofs)
+    res = pr.solve(None, fixed, vals, load_factors=[0.5, 1.0], rtol=1e-10, max_iter=40,
+                   line_search=True)
+    assert res.converged, res.reason
+    assert loading._ORDERS                              # orderings of the patterns seen
+    steps = loading.LoadSteps(pr, None, fixed, vals, "residual", None)
+    A = pr.tangent(pr.internal_force(res.U, res.slip)[1])[steps.free][:, steps.free].tocsc()
+    A.sort_indices()
+    b = np.random.default_rng(0).standard_normal(A.shape[0])
+    loading._ordered_splu(pr, A, "key")                  # a new pattern: COLAMD, kept
+    lu = loading._ordered_splu(pr, A, "key")             # its ordering reused
+    assert isinstance(lu, loading._PermutedLU)
+    np.testing.assert_array_equal(lu.solve(b), spla.splu(A).solve(b))
+    pr2, fixed, vals = problem()
+    res2 = pr2.solve(None, fixed, vals, load_factors=[0.5, 1.0], rtol=1e-10, max_iter=40,
+                     line_search=True, lu_ordering="MMD_AT_PLUS_A")
+    assert res2.converged, res2.reason
+    np.testing.assert_allclose(res2.U, res.U, atol=1e-8 * np.abs(res.U).max())
+    with pytest.raises(ValueError, match="lu_ordering"):
+        pr2.solve(None, fixed, vals, lu_ordering="AMD")

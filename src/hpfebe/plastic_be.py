@@ -73,6 +73,7 @@ H = 450).**  Two things matter, both measured (notes in tests/test_plastic_be.py
 
 from __future__ import annotations
 
+import numba
 import numpy as np
 import scipy.linalg as sla
 import scipy.sparse as sp
@@ -101,9 +102,26 @@ _EPS_SEL[2, 0, 1] = _EPS_SEL[2, 1, 0] = 0.5
 def _times_blocks(A: np.ndarray, D: np.ndarray) -> np.ndarray:
     """A @ blockdiag(D) for A (m, 3 n) and n blocks D (n, 3, 3), without forming the
     block diagonal matrix."""
+    A = np.ascontiguousarray(A, dtype=float)  # a column selection M[:, p] may be strided
+    return _times_blocks_kernel(A, np.ascontiguousarray(D, dtype=float))
+
+
+@numba.njit(cache=True)
+def _times_blocks_kernel(A, D):
+    """The 1 x 3 by 3 x 3 products of :func:`_times_blocks` in the summation order of
+    np.matmul's small-matrix loop (the same numbers bit for bit, measured; the BE/BE
+    results depend on the round-off of every step), ~6x faster than the batched
+    matmul."""
     m, n = A.shape[0], D.shape[0]
-    A = np.ascontiguousarray(A)             # a column selection M[:, p] may be strided
-    return np.matmul(A.reshape(m, n, 1, 3), D[None]).reshape(m, 3 * n)
+    out = np.empty((m, 3 * n))
+    for r in range(m):
+        for j in range(n):
+            for col in range(3):
+                acc = 0.0
+                for k in range(3):
+                    acc += A[r, 3 * j + k] * D[j, k, col]
+                out[r, 3 * j + col] = acc
+    return out
 
 
 def _graded_rule(levels: int = 4, order: int = 8):

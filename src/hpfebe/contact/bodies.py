@@ -13,6 +13,9 @@ The protocol:
                               body returns its return-map force and algorithmic tangent,
                               with its history updated per call ...
     commit(u)                 ... and committed when a load step converges
+    internal_force_lazy(u)    optional: (f_int(u), a callable returning the tangent), for
+                              a body whose tangent costs more than its force (plastic):
+                              TwoBodyContact assembles it only for a Newton step
     segments(labels)          straight pieces of the contact boundary: end points a, b, end
                               vertex ids, outward unit normals, the body's facet/element ids
     trace(ids, s)             dofs -> displacement at a + s (b - a) of segments ``ids``:
@@ -293,6 +296,11 @@ class PlasticFEBody(FEBody):
 
     def internal_force(self, u):
         return self.plastic.internal_force(self.offset + u)
+
+    def internal_force_lazy(self, u):
+        """(f_int, a callable returning the tangent): the tangent only when asked for
+        (:meth:`ElastoPlasticFE.internal_force_lazy`)."""
+        return self.plastic.internal_force_lazy(self.offset + u)
 
     def commit(self, u) -> None:
         self.plastic.commit(self.offset + u)

@@ -69,6 +69,13 @@ def _kkt_met(r, A, x, tol, nb, bound_Ax):
 
 
 @njit(cache=True)
+def _frobenius_bound(A):
+    """||A||_F (1 + 1e-8): the factor of the rigorous bound ||A x|| <= ||A||_F ||x||
+    (:func:`_kkt_met`)."""
+    return np.sqrt(np.sum(A * A)) * (1.0 + 1e-8)
+
+
+@njit(cache=True)
 def _polyak_kernel(A, b, u, x, tol, max_iter, res):
     """The iteration of :func:`projected_cg` (compiled; the same floating-point
     operations in the same order as the numpy formulation it replaces: BLAS gemv / dot,
@@ -77,10 +84,48 @@ def _polyak_kernel(A, b, u, x, tol, max_iter, res):
     already <= u) is overwritten; the KKT residuals go into ``res``.  Returns
     (status, steps, n_residuals): status 0 max_iter, 1 converged, 2 non-finite gradient,
     3 not positive definite on the free set."""
+    return _polyak_core(A, b, u, x, tol, max_iter, res, _frobenius_bound(A))
+
+
+@njit(cache=True)
+def _uzawa_step(A, b, Fw, rhoF, Qt, upper, lam, x, tol, max_iter, res, nA, lam_new):
+    """One iteration of Algorithm 4.4 compiled (:meth:`MortarContact.uzawa`; the same
+    floating-point operations as its numpy formulation): the contact QP with the
+    friction load, rhs = b - (0, F w lambda), by :func:`_polyak_core` from the start
+    ``x`` (clipped to ``upper`` first, overwritten by the solution), then
+    lambda_new = P_Lambda(lambda + rho F (U_t - Q_t)) = clip to [-1, 1] into
+    ``lam_new``.  ``Fw``, ``rhoF``: per node; ``nA``: :func:`_frobenius_bound` of A.
+    Returns :func:`_polyak_core`'s (status, steps, n_residuals) and the size of the
+    active set (x_i >= upper_i)."""
+    nc = lam.size
+    rhs = b.copy()
+    for i in range(nc):
+        rhs[nc + i] = rhs[nc + i] - Fw[i] * lam[i]
+    for i in range(x.size):                   # np.minimum(x, upper) (NaN propagates)
+        if not (x[i] <= upper[i] or x[i] != x[i]):
+            x[i] = upper[i]
+    status, steps, nres = _polyak_core(A, rhs, upper, x, tol, max_iter, res, nA)
+    for i in range(nc):                       # np.minimum(np.maximum(v, -1), 1)
+        v = lam[i] + rhoF[i] * (x[nc + i] - Qt[i])
+        if not (v >= -1.0 or v != v):
+            v = -1.0
+        if not (v <= 1.0 or v != v):
+            v = 1.0
+        lam_new[i] = v
+    active = 0
+    for i in range(x.size):
+        if x[i] >= upper[i]:
+            active += 1
+    return status, steps, nres, active
+
+
+@njit(cache=True)
+def _polyak_core(A, b, u, x, tol, max_iter, res, nA):
+    """:func:`_polyak_kernel` with the bound factor ``nA`` = :func:`_frobenius_bound` of
+    A given (computed once for a sequence of QPs with the same A)."""
     n = b.size
     g = np.dot(A, x) - b
     nb = _norm2(b)
-    nA = np.sqrt(np.sum(A * A)) * (1.0 + 1e-8)
     steps = 0
     nres = 0
     free = np.empty(n, dtype=np.bool_)
@@ -179,11 +224,23 @@ def _projected_cg_checked(A, b, u, x0, tol: float, max_iter: int):
     x = np.minimum(np.zeros(b.size) if x0 is None else np.asarray(x0, dtype=float), u)
     res = np.empty(max_iter + 1)
     status, steps, nres = _polyak_kernel(A, b, u, x, tol, max_iter, res)
-    info = SolverInfo(status == 1, _PCG_REASONS[status])
-    info.residuals = res[:min(nres, res.size)].tolist()
-    info.iterations = int(steps)
-    info.counts = dict(cg_steps=int(steps), active=int(np.count_nonzero(x >= u)))
-    return x, info
+    return x, _pcg_info(status, steps, nres, res, int(np.count_nonzero(x >= u)))
+
+
+def _per_node(v, n: int) -> np.ndarray:
+    """``v`` (a scalar or an (n,) vector) as a contiguous float vector (n,)."""
+    if isinstance(v, np.ndarray) and v.shape == (n,) and v.dtype == np.float64 and \
+            v.flags.c_contiguous:
+        return v
+    return np.ascontiguousarray(np.broadcast_to(np.asarray(v, dtype=float), (n,)))
+
+
+def _pcg_info(status, steps, nres, res, active: int) -> SolverInfo:
+    """The SolverInfo of one projected-CG solve (:func:`_polyak_kernel`'s outputs and
+    the final active set size)."""
+    return SolverInfo(status == 1, _PCG_REASONS[status], int(steps),
+                      res[:min(nres, res.size)].tolist(),
+                      counts=dict(cg_steps=int(steps), active=int(active)))
 
 
 # --------------------------------------------------------------------------- bodies
@@ -230,10 +287,21 @@ class CondensedBody:
         return u
 
     def solve(self, load_c) -> np.ndarray:
-        """Contact values of the Neumann problem A u_c = b + load_c."""
+        """Contact values of the Neumann problem A u_c = b + load_c (the Cholesky factor
+        of A once; LAPACK potrs directly - what scipy's cho_solve calls, without its
+        per-call checks)."""
         if self._choA is None:
             self._choA = sla.cho_factor(self.A)
-        return sla.cho_solve(self._choA, self.b + load_c)
+            self._potrs = sla.get_lapack_funcs("potrs", (self._choA[0],))
+        rhs = np.asarray(self.b + load_c, dtype=float)
+        if rhs.shape != self.b.shape or not np.isfinite(rhs).all():
+            raise ValueError(f"load_c must be a finite vector of shape {self.b.shape}")
+        if rhs.size == 0:
+            return rhs.copy()
+        x, info = self._potrs(self._choA[0], rhs, lower=self._choA[1])
+        if info != 0:
+            raise ValueError(f"illegal value in argument {-info} of potrs")
+        return x
 
     def reaction(self, u_c) -> np.ndarray:
         """(S U - L) on the contact dofs (the residual functional, Algorithm 4.3 step 5)."""
@@ -458,7 +526,8 @@ class MortarContact:
         """Normal and tangential components at the contact nodes of an interleaved
         vector on the contact dofs of body 1."""
         v = np.asarray(v).reshape(self.nc, 2)
-        return np.sum(v * self.n, axis=1), np.sum(v * self.t, axis=1)
+        n, t = self.n, self.t        # (two terms: the same sums as np.sum(v * n, axis=1))
+        return v[:, 0] * n[:, 0] + v[:, 1] * n[:, 1], v[:, 0] * t[:, 0] + v[:, 1] * t[:, 1]
 
     def contact_qp(self, Q, lam, x0=None, tol: float = 1e-11, bound=None):
         """Algorithm 4.4 step 2: frictionless contact of body 1 against the obstacle Q
@@ -480,13 +549,30 @@ class MortarContact:
         """The contact QP with the friction load (F w) lambda (A, b of body 1 in the
         node frames, read at every call: subclasses may replace them; compiled
         projected CG without re-validating the shapes)."""
-        rhs = np.array(self.b, dtype=float)
+        A, b, nA, _ = self._qp_matrices()
+        rhs = b.copy()
         rhs[self.nc:] -= Fw * lam
-        n = rhs.size
-        A = np.ascontiguousarray(self.A, dtype=float)
-        if A.shape != (n, n):
-            raise ValueError(f"A must be ({n}, {n}), got {A.shape}")
-        return _projected_cg_checked(A, rhs, upper, x0, float(tol), 20 * n + 100)
+        x = np.minimum(np.zeros(b.size) if x0 is None else np.asarray(x0, dtype=float),
+                       upper)
+        max_iter = 20 * b.size + 100
+        res = np.empty(max_iter + 1)
+        status, steps, nres = _polyak_core(A, rhs, upper, x, float(tol), max_iter, res, nA)
+        return x, _pcg_info(status, steps, nres, res, int(np.count_nonzero(x >= upper)))
+
+    def _qp_matrices(self):
+        """(A, b, :func:`_frobenius_bound` of A, a residual buffer) of the contact QP as
+        contiguous float arrays, built once per (A, b) pair (``self.A``, ``self.b`` are
+        read at every call: subclasses may replace them)."""
+        c = self.__dict__.get("_qp_cache")
+        if c is None or c[0] is not self.A or c[1] is not self.b:
+            A = np.ascontiguousarray(self.A, dtype=float)
+            b = np.ascontiguousarray(self.b, dtype=float)
+            n = b.size
+            if b.ndim != 1 or A.shape != (n, n):
+                raise ValueError(f"A must be ({n}, {n}), got {A.shape}")
+            c = self.__dict__["_qp_cache"] = (self.A, self.b, A, b, _frobenius_bound(A),
+                                              np.empty(20 * n + 101))
+        return c[2:]
 
     def uzawa(self, Q, rho: float = 1.0, tol: float = 1e-6, max_iter: int = 2000,
               lam0=None, x0=None, cg_tol: float = 1e-11, bound=None):
@@ -495,23 +581,45 @@ class MortarContact:
         ||lambda_m - lambda_{m-1}|| <= TOL_U ||lambda_m||.  Returns (x, lambda, info);
         x = (U_n, U_t) at the contact nodes for the returned lambda.  ``bound``: nodal
         friction bound s_j replacing F (lambda_j += rho s_j (U_t - Q_t)_j).  The QP
-        data fixed by Q and the bound are built once per call."""
+        data fixed by Q and the bound are built once per call; each iteration is one
+        compiled call (:func:`_uzawa_step`: the QP and the projection step).
+        ``info.counts``: the QP solves and their CG steps in all; ``info.steps`` holds a
+        QP's SolverInfo only where it failed (that ends the iteration) - one SolverInfo
+        per iteration kept for hundreds of thousands of iterations cost a quarter of the
+        run time in Python's garbage collector (measured on Table 4.1's capped cells)."""
         _check_pos("rho", rho)
         F = self.F if bound is None else np.asarray(bound, dtype=float)
         _, Qt = self.frame(Q)
         lam0 = np.zeros(self.nc) if lam0 is None else np.asarray(lam0, dtype=float)
         Fw, upper = self._qp_data(Q, bound)
-        rhoF = rho * F
         nc = self.nc
         state = {"x": x0}
+        A, b, nA, res = self._qp_matrices()
+        n, max_cg = b.size, res.size - 1
+        if lam0.shape != (nc,):
+            raise ValueError(f"lam0 must have shape ({nc},), got {lam0.shape}")
+        if x0 is not None and np.shape(x0) != (n,):
+            raise ValueError(f"x0 must have shape ({n},), got {np.shape(x0)}")
+        args = (A, b, _per_node(Fw, nc), _per_node(rho * F, nc), _per_node(Qt, nc),
+                _per_node(upper, n))
+        tol_cg = float(cg_tol)
+        cg = [0, 0]                                      # QP solves, CG steps
 
         def update(lam):
-            x, info = self._qp(Fw, upper, lam, state["x"], cg_tol)
+            x = np.zeros(n) if state["x"] is None else np.array(state["x"], dtype=float)
+            lam_new = np.empty(nc)
+            status, steps, nres, active = _uzawa_step(
+                *args, np.ascontiguousarray(lam, dtype=float), x, tol_cg, max_cg, res, nA,
+                lam_new)
             state["x"] = x
-            # P_Lambda: the pointwise clip to [-1, 1] (np.minimum(np.maximum(.)) = np.clip)
-            return np.minimum(np.maximum(lam + rhoF * (x[nc:] - Qt), -1.0), 1.0), info
+            cg[0] += 1
+            cg[1] += steps
+            if status != 1:                  # a failed QP ends the iteration with its info
+                return lam_new, _pcg_info(status, steps, nres, res, active)
+            return lam_new
 
         lam, info = fixed_point(update, lam0, tol, max_iter, norm=2)
+        info.counts = dict(qp_solves=cg[0], cg_steps=cg[1])
         x, qinfo = self._qp(Fw, upper, lam, state["x"], cg_tol)
         if not qinfo.converged and info.converged:
             info.converged, info.reason = False, f"final QP: {qinfo.reason}"
@@ -848,6 +956,11 @@ def contact_from_meshes(mesh1, mesh2, normal, E: float = 266926.0, nu: float = 0
     """The model problem's boundary conditions on given meshes (e.g. adaptive ones);
     ``gap``: the initial gap function (None: measured along the normal to mesh2)."""
     bem1, bem2 = LameBEM(mesh1, E, nu, plane), LameBEM(mesh2, E, nu, plane)
+    return _model_contact(bem1, bem2, normal, F, u_top, test_space, gap)
+
+
+def _model_contact(bem1, bem2, normal, F, u_top, test_space, gap) -> MortarContact:
+    """The model problem's boundary conditions on the bodies ``bem1``, ``bem2``."""
     return MortarContact(bem1, bem2, ("D", u_top), ("D", (0.0, 0.0)), F, normal=normal,
                          test_space=test_space, gap=gap)
 
@@ -856,7 +969,8 @@ def model_problem(n1: int = 16, n2: int = 12, p1: int = 2, p2: int = 2,
                   E: float = 266926.0, nu: float = 0.29, F: float = 0.1,
                   u_top=(0.0, -0.09), radius: float = 5.05, plane: str = "strain",
                   L: float = 2.0, side_depth: float = 2.0,
-                  test_space: str = "full", geometry: str = "arc") -> MortarContact:
+                  test_space: str = "full", geometry: str = "arc",
+                  bem_cache: dict | None = None) -> MortarContact:
     """The model problem of Section 4.3.4 (thesis lines 19474-19530): body 1 bounded by
     Gamma^1_D = [-1,1] x {2} (U = u_top), Gamma^1_N = {-1,1} x [0.1, 2] and the arc
     Gamma^1_C of radius ``radius`` through (-1, 0.1), (0, 0), (1, 0.1); body 2 =
@@ -866,13 +980,23 @@ def model_problem(n1: int = 16, n2: int = 12, p1: int = 2, p2: int = 2,
     p1, p2 everywhere.  Normals of Gamma^1_C: the radial direction of the circle; gap
     along it.  ``geometry="flat"``: Gamma^1_C straight, the arc only as initial gap
     (:func:`model_meshes`); ``side_depth``: Dirichlet part of body 2's sides;
-    ``test_space``: of the mortar projection (:class:`MortarContact`)."""
+    ``test_space``: of the mortar projection (:class:`MortarContact`).  ``bem_cache``: a
+    dict keeping the BE bodies (and their assembled operators) across calls - body 1
+    depends only on (n1, p1, radius, L, geometry), body 2 on (n2, p2, L, side_depth), so
+    a sweep over degree pairs assembles each body once."""
     if not np.isfinite(F) or F < 0:
         raise ValueError(f"F must be >= 0, got {F!r}")
     mesh1, mesh2, normal = model_meshes(n1, n2, p1, p2, radius, L, side_depth, geometry)
     gap = model_gap(radius) if geometry == "flat" else None
-    return contact_from_meshes(mesh1, mesh2, normal, E, nu, F, u_top, plane, test_space,
-                               gap)
+    if bem_cache is None:
+        return contact_from_meshes(mesh1, mesh2, normal, E, nu, F, u_top, plane,
+                                   test_space, gap)
+    mat = (float(E), float(nu), plane)
+    keys = ((1, int(n1), int(p1), float(radius), float(L), geometry) + mat,
+            (2, int(n2), int(p2), float(L), float(side_depth)) + mat)
+    bems = [bem_cache.get(k) or bem_cache.setdefault(k, LameBEM(m, E, nu, plane))
+            for k, m in zip(keys, (mesh1, mesh2))]
+    return _model_contact(*bems, normal, F, u_top, test_space, gap)
 
 
 # --------------------------------------------------------------------------- hp

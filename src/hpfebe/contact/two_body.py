@@ -145,6 +145,28 @@ def _trace_maps(nm, sides, ndofs):
     return Gn, Gt, tm
 
 
+class _State(dict):
+    """The contact state of :meth:`TwoBodyContact.internal_force`: a dict whose entries
+    in ``lazy`` (key -> callable) are computed on first access."""
+
+    def __init__(self, *args, **kw):
+        super().__init__(*args, **kw)
+        self.lazy = {}
+
+    def __missing__(self, key):
+        if key not in self.lazy:
+            raise KeyError(key)
+        value = self[key] = self.lazy.pop(key)()
+        return value
+
+
+def _force_lazy(body, u):
+    """(f_int, tangent or a callable returning it) of a contact body: the callable when
+    the body can defer its tangent (``internal_force_lazy``, a plastic body)."""
+    lazy = getattr(body, "internal_force_lazy", None)
+    return lazy(u) if lazy is not None else body.internal_force(u)
+
+
 @dataclass
 class ContactResult:
     """Outcome of :meth:`TwoBodyContact.solve` (and of :func:`solve_friction`).
@@ -474,12 +496,20 @@ class TwoBodyContact:
         """f_int(U) + f_c(U) and the state at U: the bodies' internal forces and tangents
         (``body.internal_force``: K U and K for a linear body, the return-map force and
         algorithmic tangent of a plastic one, from its committed history) and the
-        contact state."""
-        cs = self.contact_state(U, slip, motion)
-        (fs, Ks), (fm, Km) = (self.bodies["slave"].internal_force(U[: self.offset]),
-                              self.bodies["master"].internal_force(U[self.offset:]))
+        contact state; ``cs["K_body"]`` of a body with ``internal_force_lazy`` (plastic)
+        is assembled on its first access (a Newton step, the predictor), not at every
+        line-search trial."""
+        cs = _State(self.contact_state(U, slip, motion))
+        (fs, Ks), (fm, Km) = (_force_lazy(self.bodies["slave"], U[: self.offset]),
+                              _force_lazy(self.bodies["master"], U[self.offset:]))
         cs["f_body"] = np.concatenate([fs, fm])
-        cs["K_body"] = self._blocks(Ks, Km)
+        if callable(Ks) or callable(Km):
+            # a plastic body's tangent only when a Newton step or the predictor asks for
+            # it (not at rejected line-search trials): assembled on first access
+            cs.lazy["K_body"] = lambda: self._blocks(Ks() if callable(Ks) else Ks,
+                                                     Km() if callable(Km) else Km)
+        else:
+            cs["K_body"] = self._blocks(Ks, Km)
         cs["f_c"] = self.contact_force(cs)
         return cs["f_body"] + cs["f_c"], cs
 
@@ -533,7 +563,8 @@ class TwoBodyContact:
               min_step: float = 2.0 ** -12, max_cuts: int = 0, norm: str = "l2",
               merit: str = "residual", predictor: bool = False,
               roundoff_stop: bool = False,
-              initial: ContactResult | None = None) -> ContactResult:
+              initial: ContactResult | None = None,
+              lu_ordering: str = "COLAMD") -> ContactResult:
         """Incremental loading with semismooth Newton (Algorithm 4.1,
         :func:`hpfebe.nonlinear.load_path`).
 
@@ -553,8 +584,12 @@ class TwoBodyContact:
         state is then detected.  ``predictor``: start each step from the bonded
         solution (every point in contact and sticking) when it lowers the merit.
         ``initial``: a converged result of this problem to continue from (U, slip,
-        load and obstacle motion ramped from its final values)."""
-        steps = LoadSteps(self, f_ext, fixed_dofs, fixed_values, merit, initial)
+        load and obstacle motion ramped from its final values).  ``lu_ordering``: the
+        column ordering of the sparse LU of a system with an FE body
+        (:data:`hpfebe.contact.loading.LU_ORDERINGS`: "COLAMD", SuperLU's default, or
+        "MMD_AT_PLUS_A", faster, other round-off)."""
+        steps = LoadSteps(self, f_ext, fixed_dofs, fixed_values, merit, initial,
+                          lu_ordering)
         lf = np.asarray(load_factors, dtype=float).ravel()
         if lf.size == 0 or not np.all(np.isfinite(lf)):
             raise ValueError(f"load_factors must be a non-empty finite sequence, got {load_factors!r}")

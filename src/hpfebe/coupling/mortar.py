@@ -247,5 +247,13 @@ class MortarProjection:
         a functional on X^2_hp (values on ``dofs2``)."""
         if self.P is not None:
             return self._apply(r1, self.dofs1.size, lambda V: self.P.T @ V)
-        return self._apply(r1, self.dofs1.size,
-                           lambda V: self.B.T @ self._lu.solve(V, trans="T"))
+        BT = self._transpose_B()
+        return self._apply(r1, self.dofs1.size, lambda V: BT @ self._lu.solve(V, trans="T"))
+
+    def _transpose_B(self):
+        """B^T (the sparse matrix ``self.B.T``), formed once per B: the adjoint is applied
+        in every DtN iteration and forming the transpose costs more than the product."""
+        cached = self.__dict__.get("_BT")
+        if cached is None or cached[0] is not self.B:
+            cached = self.__dict__["_BT"] = (self.B, self.B.T)
+        return cached[1]

@@ -31,6 +31,7 @@ prescribed displacements and loads (no contact), for :func:`hpfebe.nonlinear.loa
 from __future__ import annotations
 
 
+import numba
 import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
@@ -39,9 +40,46 @@ from skfem import Basis, ElementQuad1, ElementTriP1, ElementVector, MeshQuad, Me
 from ..nonlinear import Iterate, SingularStep
 from .elasticity import ElasticBody
 from .meshes import FEDomain
-from .plasticity import J2Material, J2State, dev, return_map, tensor_norm, TANGENTS
+from .plasticity import (J2Material, J2State, consistent_tangent, dev, return_map,
+                         tensor_norm, TANGENTS)
 
 FORMULATIONS = ("bbar", "full")
+
+
+# The two per-iterate contractions of the body, as loops in the summation order of
+# np.einsum("eqia,ei->eqa") and np.einsum("eqia,eqa,eq->ei") (the same numbers bit for
+# bit, measured; the stamping results depend on the round-off of every Newton step),
+# 3-4x faster than einsum.
+@numba.njit(cache=True)
+def _strain_kernel(B, ue):
+    """eps[e, q, a] = sum_i B[e, q, i, a] ue[e, i]."""
+    ne, nq, nl, na = B.shape
+    out = np.empty((ne, nq, na))
+    for e in range(ne):
+        for q in range(nq):
+            for a in range(na):
+                acc = 0.0
+                for i in range(nl):
+                    acc += B[e, q, i, a] * ue[e, i]
+                out[e, q, a] = acc
+    return out
+
+
+@numba.njit(cache=True)
+def _force_kernel(B, s, dx):
+    """f[e, i] = sum_q sum_a B[e, q, i, a] s[e, q, a] dx[e, q]."""
+    ne, nq, nl, na = B.shape
+    out = np.empty((ne, nl))
+    for e in range(ne):
+        for i in range(nl):
+            tot = 0.0
+            for q in range(nq):
+                acc = 0.0
+                for a in range(na):
+                    acc += B[e, q, i, a] * s[e, q, a] * dx[e, q]
+                tot += acc
+            out[e, i] = tot
+    return out
 
 
 class ElastoPlasticFE:
@@ -71,7 +109,8 @@ class ElastoPlasticFE:
         self.basis = Basis(mesh, ElementVector(elem), intorder=order)
         self.dx = self.basis.dx                                   # (nel, nq)
         self.nel, self.nq = self.dx.shape
-        self.B = self._strain_operator()                          # (nel, nq, nloc, 9)
+        self.B = np.ascontiguousarray(self._strain_operator())    # (nel, nq, nloc, 9)
+        self._dx_c = np.ascontiguousarray(self.dx, dtype=float)
         dofs = self.basis.element_dofs                            # (nloc, nel)
         self.element_dofs = dofs
         nloc = dofs.shape[0]
@@ -79,8 +118,11 @@ class ElastoPlasticFE:
         self._cols = np.tile(dofs.T, (1, nloc)).ravel()
         self.committed = J2State.zeros(self.nel * self.nq)
         self.sigma = np.zeros((self.nel * self.nq, 3, 3))          # committed stress
-        self.K = self._assemble(np.broadcast_to(material.elastic_tangent().reshape(9, 9),
-                                                (self.nel, self.nq, 9, 9)))
+        # element matrices of the elastic tangent: the tangent of an element whose
+        # points are all elastic (the same numbers as assembling it there, bit for bit)
+        self._Ke_el = self._element_matrices(np.ascontiguousarray(np.broadcast_to(
+            material.elastic_tangent().reshape(9, 9), (self.nel, self.nq, 9, 9))))
+        self.K = self._coo(self._Ke_el)
         self._cache = None
 
     # ------------------------------------------------------------------ kinematics
@@ -110,36 +152,72 @@ class ElastoPlasticFE:
         u = np.asarray(u, dtype=float)
         if u.shape != (self.ndofs,):
             raise ValueError(f"u must have shape ({self.ndofs},), got {u.shape}")
-        ue = u[self.element_dofs].T                                 # (nel, nloc)
-        eps = np.einsum("eqia,ei->eqa", self.B, ue)
+        ue = np.ascontiguousarray(u[self.element_dofs].T)           # (nel, nloc)
+        eps = _strain_kernel(self.B, ue)
         return eps.reshape(-1, 3, 3)
 
     def _assemble(self, C: np.ndarray) -> sp.csr_matrix:
         """sum_K sum_q w_q B^T C B with C (nel, nq, 9, 9)."""
-        CB = C @ np.swapaxes(self.B, -1, -2)                        # (nel, nq, 9, nloc)
-        BCB = self.B @ CB                                           # (nel, nq, nloc, nloc)
-        Ke = np.einsum("eqij,eq->eij", BCB, self.dx)
+        return self._coo(self._element_matrices(C))
+
+    def _element_matrices(self, C: np.ndarray, elements=None) -> np.ndarray:
+        """Element matrices sum_q w_q B^T C B (n, nloc, nloc) of the ``elements`` (None =
+        all) with C (n, nq, 9, 9) on their points; elementwise, so a subset gives the
+        numbers of the full set."""
+        B, dx = (self.B, self.dx) if elements is None else (self.B[elements],
+                                                             self.dx[elements])
+        CB = C @ np.swapaxes(B, -1, -2)                             # (n, nq, 9, nloc)
+        BCB = B @ CB                                                # (n, nq, nloc, nloc)
+        return np.einsum("eqij,eq->eij", BCB, dx)
+
+    def _coo(self, Ke: np.ndarray) -> sp.csr_matrix:
         A = sp.coo_matrix((Ke.ravel(), (self._rows, self._cols)), shape=(self.ndofs,) * 2)
         return A.tocsr()
 
+    def tangent_matrix(self, rm, tangent: str | None = None) -> sp.csr_matrix:
+        """The tangent (4.36)-(4.37) of the return map ``rm`` (:meth:`state_at`):
+        assembled from the consistent tangent at the points of the elements with a
+        plastic point only, the elastic element matrices elsewhere (the numbers of the
+        full assembly, bit for bit; the elastic stiffness K itself if no point is
+        plastic)."""
+        tg = self.tangent if tangent is None else tangent
+        pe = np.flatnonzero(rm.plastic.reshape(self.nel, self.nq).any(axis=1))
+        if pe.size == 0:
+            return self.K
+        pts = (pe[:, None] * self.nq + np.arange(self.nq)).ravel()
+        C = consistent_tangent(self.material, rm, tg, pts).reshape(pe.size, self.nq, 9, 9)
+        Ke = self._Ke_el.copy()
+        Ke[pe] = self._element_matrices(C, pe)
+        return self._coo(Ke)
+
     def _force(self, sigma: np.ndarray) -> np.ndarray:
-        s = sigma.reshape(self.nel, self.nq, 9)
-        fe = np.einsum("eqia,eqa,eq->ei", self.B, s, self.dx)
+        s = np.ascontiguousarray(sigma.reshape(self.nel, self.nq, 9))
+        fe = _force_kernel(self.B, s, self._dx_c)
         return np.bincount(self.element_dofs.T.ravel(), fe.ravel(), minlength=self.ndofs)
 
     # ------------------------------------------------------------------ protocol
+    def state_at(self, u: np.ndarray):
+        """The return map at u from the committed history without its tangent:
+        (f_int, :class:`~hpfebe.fem.plasticity.ReturnMap`), cached for the last u; the
+        tangent follows from :meth:`tangent_matrix` when it is needed (a Newton step,
+        not a rejected line-search trial)."""
+        key = np.asarray(u, dtype=float)
+        if self._cache is not None and np.array_equal(self._cache[0], key):
+            return self._cache[1], self._cache[2]
+        rm = return_map(self.material, self.strain(key), self.committed, None)
+        f = self._force(rm.sigma)
+        self._cache = (key.copy(), f, rm, {})
+        return f, rm
+
     def response(self, u: np.ndarray, tangent: str | None = None):
         """The return map at u from the committed history: (f_int, tangent matrix,
-        :class:`~hpfebe.fem.plasticity.ReturnMap`)."""
-        key = np.asarray(u, dtype=float)
+        :class:`~hpfebe.fem.plasticity.ReturnMap`); the ReturnMap's pointwise tangent
+        is not formed (:func:`~hpfebe.fem.plasticity.consistent_tangent` gives it)."""
         tg = self.tangent if tangent is None else tangent
-        if self._cache is not None and self._cache[1] == tg and \
-                np.array_equal(self._cache[0], key):
-            return self._cache[2]
-        rm = return_map(self.material, self.strain(key), self.committed, tg)
-        f = self._force(rm.sigma)
-        T = self._assemble(rm.tangent.reshape(self.nel, self.nq, 9, 9))
-        self._cache = (key.copy(), tg, (f, T, rm))
+        f, rm = self.state_at(u)
+        T = self._cache[3].get(tg)
+        if T is None:
+            T = self._cache[3][tg] = self.tangent_matrix(rm, tg)
         return f, T, rm
 
     def internal_force(self, u: np.ndarray):
@@ -147,9 +225,15 @@ class ElastoPlasticFE:
         f, T, _ = self.response(u)
         return f, T
 
+    def internal_force_lazy(self, u: np.ndarray):
+        """(f_int(u), a callable returning the tangent at u): the tangent is assembled
+        only when called (:meth:`internal_force` gives both at once)."""
+        f, rm = self.state_at(u)
+        return f, lambda: self.tangent_matrix(rm)
+
     def commit(self, u: np.ndarray) -> None:
         """The state at u becomes the committed history (after a converged load step)."""
-        _, _, rm = self.response(u)
+        _, rm = self.state_at(u)
         self.committed = rm.state.copy()
         self.sigma = rm.sigma.copy()
         self._cache = None

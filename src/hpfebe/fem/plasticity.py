@@ -152,7 +152,9 @@ class J2State:
 class ReturnMap:
     """Result of :func:`return_map` at N points: stress (N, 3, 3), the trial-updated
     state, the tangent (N, 3, 3, 3, 3) (None if not asked for), dgamma (N,), the plastic
-    flag (N,) and the trial yield function value (N,)."""
+    flag (N,), the trial yield function value (N,), and the flow direction and trial
+    norm from which :func:`consistent_tangent` computes the tangent later (at a subset
+    of the points)."""
 
     sigma: np.ndarray
     state: J2State
@@ -160,6 +162,8 @@ class ReturnMap:
     dgamma: np.ndarray
     plastic: np.ndarray
     f_trial: np.ndarray
+    normal: np.ndarray | None = None      # n = eta_trial / ||eta_trial|| (N, 3, 3)
+    eta_norm: np.ndarray | None = None    # ||eta_trial||, 1 where it is 0 (N,)
 
 
 def return_map(mat: J2Material, eps: np.ndarray, committed: J2State,
@@ -190,15 +194,32 @@ def return_map(mat: J2Material, eps: np.ndarray, committed: J2State,
     state = J2State(committed.eps_p + dg * n, committed.alpha + SQ23 * dgamma,
                     committed.beta + (2.0 / 3.0) * (1.0 - th) * H * dg * n)
     sigma = kappa * tr[:, None, None] * _I3 + s_trial - 2.0 * mu * dg * n
-    C = None
+    rm = ReturnMap(sigma, state, None, dgamma, plastic, f_trial, n, safe)
     if tangent is not None:
-        if tangent == "algorithmic":
-            theta1 = 1.0 - 2.0 * mu * dgamma / safe
-        else:
-            theta1 = np.ones_like(dgamma)
-        theta_bar = np.where(plastic, 1.0 / (1.0 + H / (3.0 * mu)) - (1.0 - theta1), 0.0)
-        theta1 = np.where(plastic, theta1, 1.0)
-        C = (kappa * ONE_ONE[None] + 2.0 * mu * theta1[:, None, None, None, None] * P_DEV[None]
-             - 2.0 * mu * theta_bar[:, None, None, None, None]
-             * np.einsum("nij,nkl->nijkl", n, n))
-    return ReturnMap(sigma, state, C, dgamma, plastic, f_trial)
+        rm.tangent = consistent_tangent(mat, rm, tangent)
+    return rm
+
+
+def consistent_tangent(mat: J2Material, rm: ReturnMap, tangent: str = "algorithmic",
+                       points: np.ndarray | None = None) -> np.ndarray:
+    """The tangent (M, 3, 3, 3, 3) of the return map ``rm`` (module doc: "algorithmic"
+    (4.42)-(4.43) or "continuum") at ``points`` (indices; None = all N points), from its
+    flow direction and trial norm; pointwise, so a subset gives the same numbers as the
+    full set.  At an elastic point it is the elastic tangent C, bit for bit."""
+    if tangent not in TANGENTS:
+        raise ValueError(f"tangent must be one of {TANGENTS}, got {tangent!r}")
+    if rm.normal is None or rm.eta_norm is None:
+        raise ValueError("rm must come from return_map (flow direction and trial norm)")
+    sel = slice(None) if points is None else np.asarray(points, dtype=np.int64)
+    n, safe, dgamma, plastic = rm.normal[sel], rm.eta_norm[sel], rm.dgamma[sel], \
+        rm.plastic[sel]
+    mu, kappa, H = mat.mu, mat.kappa, mat.H
+    if tangent == "algorithmic":
+        theta1 = 1.0 - 2.0 * mu * dgamma / safe
+    else:
+        theta1 = np.ones_like(dgamma)
+    theta_bar = np.where(plastic, 1.0 / (1.0 + H / (3.0 * mu)) - (1.0 - theta1), 0.0)
+    theta1 = np.where(plastic, theta1, 1.0)
+    return (kappa * ONE_ONE[None] + 2.0 * mu * theta1[:, None, None, None, None] * P_DEV[None]
+            - 2.0 * mu * theta_bar[:, None, None, None, None]
+            * np.einsum("nij,nkl->nijkl", n, n))
