@@ -9,7 +9,8 @@ first instead, and only the modules that call numba wait for it.
 The scenes are tiny and go through the public API, so they compile exactly the
 specialisations (argument types) that the experiments use: the BEM assembly of the
 Laplace and Lame operators, the potentials at interior points, the gradient of the single
-layer on Gamma (the residual estimator), boundary-curve checks, and Polyak's projected CG.
+layer on Gamma (the residual estimator), boundary-curve checks, Polyak's projected CG and
+the Uzawa step of the mortar solvers, and the strain/force kernels of the plastic body.
 """
 
 from __future__ import annotations
@@ -53,12 +54,29 @@ def _bem(steps: dict) -> None:
 
 
 def _contact(steps: dict) -> None:
-    from .contact.mortar import projected_cg
+    from .contact.mortar import model_problem, projected_cg
 
     t = time.perf_counter()
     A = np.array([[2.0, -1.0], [-1.0, 2.0]])
     projected_cg(A, np.array([1.0, 1.0]), np.array([0.1, np.inf]))
     steps["projected_cg"] = time.perf_counter() - t
+
+    t = time.perf_counter()
+    mc = model_problem(n1=2, n2=2, p1=1, p2=1)
+    mc.uzawa(np.zeros(2 * len(mc.points)), max_iter=2)
+    steps["uzawa"] = time.perf_counter() - t
+
+
+def _plastic(steps: dict) -> None:
+    from .fem.elasticity import rectangle_mesh
+    from .fem.plastic_body import ElastoPlasticFE
+    from .fem.plasticity import J2Material
+
+    t = time.perf_counter()
+    body = ElastoPlasticFE(rectangle_mesh(0.0, 1.0, 0.0, 1.0, 2, 2),
+                           J2Material(1.0, 0.3, 1.0, 0.1))
+    body.internal_force(np.zeros(body.ndofs))
+    steps["plasticity"] = time.perf_counter() - t
 
 
 def compile_kernels() -> dict[str, float]:
@@ -67,4 +85,5 @@ def compile_kernels() -> dict[str, float]:
     steps: dict[str, float] = {}
     _bem(steps)
     _contact(steps)
+    _plastic(steps)
     return steps
