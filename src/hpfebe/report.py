@@ -449,7 +449,7 @@ def _timing_rows(entries, compiled: dict | None = None):
     rows, tot = [], [0.0, 0.0, 0.0]
     if compiled and mods:
         vals = [compiled["wall_s"], compiled["jit_compile_s"], compiled["jit_s"]]
-        rows.append(["numba kernels (`hpfebe compile`, first job)", "-"]
+        rows.append(["numba kernels (`hpfebe compile`, its last run)", "-"]
                     + [_fmt_s(v) for v in vals])
         tot = vals
     for mod in sorted(mods):

@@ -171,7 +171,7 @@ def _far_tables(mesh, space, coef, nf: int):
     Y[:, :, 1] = a[:, 1, None] + s[None, :] * u[:, 1, None]
     phi = tab[mesh.degrees]                                  # (ne, m, pmax + 1)
     dofs = space.elem_dofs
-    nl = np.array([n_local(space.kind, int(p)) for p in mesh.degrees])
+    nl = mesh.degrees + (0 if space.kind == 0 else 1)         # n_local per element
     FV = np.zeros((len(a), m, coef.shape[1]))
     for j in range(dofs.shape[1]):
         on = (dofs[:, j] >= 0) & (j < nl)
