@@ -441,14 +441,9 @@ def _displacement_panels(bodies: dict):
     return fig, axes
 
 
-def field_figure(bodies: dict, ranges: pd.DataFrame, r: Run) -> Figure:
-    """Row 1: work piece u_x, u_y, ||dev sigma||; row 2: stamp u_x, u_y and the colorbar
-    ranges beside the published ones."""
-    fig, axes = _displacement_panels(bodies)
-    p, cells, _ = bodies["work"]
-    dev = r.peak.fields["dev_sigma_norm"]
-    _panel(fig, axes[0, 2], p, cells, dev, (0.0, dev.max()), "work piece: ||dev sigma||",
-           "%.2f")
+def _finish_dev_and_ranges(axes, ranges: pd.DataFrame) -> None:
+    """Both figures' last column: the work piece's ||dev sigma|| panel framed like the
+    displacement panels, and the colorbar ranges (ours | thesis) as text below it."""
     axes[0, 2].set_xlim(*LIMITS["work"][0])
     axes[0, 2].set_ylim(*LIMITS["work"][1])
     axes[0, 2].set_aspect("equal")
@@ -458,6 +453,17 @@ def field_figure(bodies: dict, ranges: pd.DataFrame, r: Run) -> Figure:
         + ("max " if np.isnan(x.published_min) else f"{x.published_min:.3e}..")
         + f"{x.published_max:.3e}" for x in ranges.itertuples()]
     axes[1, 2].text(0.0, 0.5, "\n".join(lines), fontsize=7, va="center", family="monospace")
+
+
+def field_figure(bodies: dict, ranges: pd.DataFrame, r: Run) -> Figure:
+    """Row 1: work piece u_x, u_y, ||dev sigma||; row 2: stamp u_x, u_y and the colorbar
+    ranges beside the published ones."""
+    fig, axes = _displacement_panels(bodies)
+    p, cells, _ = bodies["work"]
+    dev = r.peak.fields["dev_sigma_norm"]
+    _panel(fig, axes[0, 2], p, cells, dev, (0.0, dev.max()), "work piece: ||dev sigma||",
+           "%.2f")
+    _finish_dev_and_ranges(axes, ranges)
     fig.suptitle(f"penalty FE/BE, 1/eps_n = {r.factor:g} E_m, 1/eps_t = half, full lift "
                  "1e-4", fontsize=10)
     return fig
@@ -1005,15 +1011,7 @@ def mortar_figure(bodies: dict, ranges: pd.DataFrame, sol, pr, title: str) -> Fi
     plastic = f["eps_p_norm_mean"] > 0
     ax.add_collection(PolyCollection(p[cells[plastic]], facecolors="none",
                                      edgecolors="k", linewidths=0.4))
-    ax.set_xlim(*LIMITS["work"][0])
-    ax.set_ylim(*LIMITS["work"][1])
-    ax.set_aspect("equal")
-    axes[1, 2].axis("off")
-    lines = ["colorbar ranges: ours | thesis"] + [
-        f"{x.body} {x.field}: {x.ours_min:.3e}..{x.ours_max:.3e} | "
-        + ("max " if np.isnan(x.published_min) else f"{x.published_min:.3e}..")
-        + f"{x.published_max:.3e}" for x in ranges.itertuples()]
-    axes[1, 2].text(0.0, 0.5, "\n".join(lines), fontsize=7, va="center", family="monospace")
+    _finish_dev_and_ranges(axes, ranges)
     fig.suptitle(title, fontsize=10)
     return fig
 

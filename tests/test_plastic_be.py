@@ -121,18 +121,9 @@ def test_implicit_reversed_path_follows_material_point(punch_bodies, theta):
 
 
 def punch_fe(fem, depth, lams):
-    fe = ElastoPlasticFE(fem, MAT)
-    b = fe.elastic
-    xy = b.dof_coordinates()
-    bottom = b.dofs_on("bottom")
-    top = b.dofs_on("top", 1)
-    top = top[np.abs(xy[top, 0]) < 0.5 + 1e-9]
-    ds = DisplacementSteps(fe, np.concatenate([bottom, top]),
-                           np.concatenate([np.zeros(bottom.size), -depth * np.ones(top.size)]))
-    _, info = load_path(ds, lams, np.zeros(fe.ndofs), tol=1e-10, max_iter=40)
-    assert info.converged
+    R, fe = punch_fe_mat(fem, MAT, depth, lams)
     eps_p = fe.committed.eps_p.reshape(fe.nel, fe.nq, 3, 3).mean(axis=1)
-    return fe.committed_force()[top].sum(), tensor_norm(eps_p)
+    return R, tensor_norm(eps_p)
 
 
 def punch_be(be, depth, lams, max_iter):
@@ -314,7 +305,10 @@ def test_crossed_cells_do_not_lock_on_thesis_material():
     assert be.inner_info.converged and be.plastic.sum() > 0
 
 
-def punch_fe_mat(fem, mat, depth):
+def punch_fe_mat(fem, mat, depth, lams=None):
+    """The FE punch (B-bar Q1): bottom fixed, the top's |x| <= 1/2 pressed down by
+    ``depth`` along ``lams`` (default ten equal steps); (reaction on the punch, the body)."""
+    lams = np.linspace(0.1, 1, 10) if lams is None else lams
     fe = ElastoPlasticFE(fem, mat)
     b = fe.elastic
     xy = b.dof_coordinates()
@@ -323,8 +317,7 @@ def punch_fe_mat(fem, mat, depth):
     top = top[np.abs(xy[top, 0]) < 0.5 + 1e-9]
     ds = DisplacementSteps(fe, np.concatenate([bottom, top]),
                            np.concatenate([np.zeros(bottom.size), -depth * np.ones(top.size)]))
-    _, info = load_path(ds, np.linspace(0.1, 1, 10), np.zeros(fe.ndofs), tol=1e-10,
-                        max_iter=40)
+    _, info = load_path(ds, lams, np.zeros(fe.ndofs), tol=1e-10, max_iter=40)
     assert info.converged
     return fe.committed_force()[top].sum(), fe
 
