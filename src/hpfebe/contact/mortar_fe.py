@@ -172,19 +172,7 @@ class _BandSteps(DisplacementSteps):
     (symmetric positive definite) consistent tangent on the free dofs by the banded
     Cholesky factorisation (:class:`_BandPattern`, built once for the tangent's
     sparsity pattern: the free-free block is gathered from the tangent's values by a
-    fixed index), SuperLU where that declines; the tangent is assembled only for a Newton
-    step (not at the rejected line-search trials and the converged iterate) where the
-    body offers ``internal_force_lazy``."""
-
-    def evaluate(self, x: np.ndarray) -> Iterate:
-        lazy = getattr(self.body, "internal_force_lazy", None)
-        if lazy is None:
-            return super().evaluate(x)
-        f, tangent = lazy(x)                  # the same f_int as internal_force
-        r = f[self.free] - self.lam * self.f_ext[self.free]
-        scale = max(float(np.abs(f).max(initial=0.0)),
-                    float(np.abs(self.lam * self.f_ext).max(initial=0.0)), 1e-300)
-        return Iterate(x, r, 0.5 * float(r @ r), scale, None, tangent)
+    fixed index), SuperLU where that declines."""
 
     def _free_block(self, T):
         """(values of T[free][:, free] in CSR order, its :class:`_BandPattern`); the
@@ -202,7 +190,7 @@ class _BandSteps(DisplacementSteps):
         return T.data[c[2]], c[3]
 
     def step(self, it: Iterate) -> np.ndarray:
-        T = it.data() if callable(it.data) else it.data       # the tangent (maybe lazy)
+        T = self.tangent(it)
         if sp.issparse(T) and T.format == "csr" and T.has_canonical_format:
             vals, pattern = self._free_block(T)
             d = pattern.solve(vals, -it.residual)

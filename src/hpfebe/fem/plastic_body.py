@@ -342,7 +342,10 @@ class DisplacementSteps:
 
     # NewtonProblem
     def evaluate(self, x: np.ndarray) -> Iterate:
-        f, T = self.body.internal_force(x)
+        # the tangent only when a Newton step asks for it (not at rejected line-search
+        # trials and the converged iterate): ``data`` may be a callable returning it
+        lazy = getattr(self.body, "internal_force_lazy", None)
+        f, T = lazy(x) if lazy is not None else self.body.internal_force(x)
         r = f[self.free] - self.lam * self.f_ext[self.free]
         scale = max(float(np.abs(f).max(initial=0.0)),
                     float(np.abs(self.lam * self.f_ext).max(initial=0.0)), 1e-300)
@@ -351,8 +354,13 @@ class DisplacementSteps:
     def slope(self, it: Iterate, dx: np.ndarray) -> float:
         return -2.0 * it.merit
 
+    @staticmethod
+    def tangent(it: Iterate):
+        """The tangent of an iterate of :meth:`evaluate` (assembled now if deferred)."""
+        return it.data() if callable(it.data) else it.data
+
     def step(self, it: Iterate) -> np.ndarray:
-        A = it.data[self.free][:, self.free].tocsc()
+        A = self.tangent(it)[self.free][:, self.free].tocsc()
         try:
             d = spla.spsolve(A, -it.residual)
         except RuntimeError as e:                                   # singular factor
