@@ -407,8 +407,7 @@ def cmd_run(args) -> int:
 
     import matplotlib
 
-    matplotlib.use("Agg", force=True)
-    import matplotlib.pyplot as plt
+    matplotlib.use("Agg", force=True)  # figures are plain Figure objects (no pyplot)
 
     from . import results as res
 
@@ -459,8 +458,6 @@ def cmd_run(args) -> int:
     for r in results:
         paths = res.write_result(r, out, section, run_info=run_info)
         log.info("wrote %s", ", ".join(str(p) for p in paths))
-        if r.figure is not None:
-            plt.close(r.figure)
     return EXIT_OK
 
 
