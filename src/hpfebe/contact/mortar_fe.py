@@ -403,6 +403,14 @@ class FEMortarContact(MortarContact):
 
         P, info = fixed_point(update, np.zeros(self.c2.size), tol, max_iter, norm=2,
                               divergence=divergence)
+        return self._dtn_solution(P, info, st, rho, load2, newton_tol, newton_max_iter,
+                                  coupling_tol)
+
+    def _dtn_solution(self, P, info: SolverInfo, st: dict, rho: float, load2, newton_tol,
+                      newton_max_iter, coupling_tol) -> MortarSolution:
+        """The end of :meth:`dtn`: iteration counts, U2 of the final P, and the backward
+        error of the transfer (a converged P must make the obstacle Q the work piece)."""
+        m = self.mortar
         info.counts = dict(
             uzawa_first=info.steps[0].counts.get("uzawa", 0) if info.steps else 0,
             uzawa_total=int(sum(s.counts.get("uzawa", 0) for s in info.steps)),
