@@ -78,8 +78,8 @@ def waits_for_numba(exp):
 
 # Longest modules first (two jobs on two cores: the run ends when its longest module
 # does; the report's Timing table has the measured times).  Others get priority 0.
-LONGEST_FIRST = ["ch4_plasticity", "ch4_section44", "ch2_convergence", "ch4_adaptive_fefe",
-                 "ch4_mortar", "ch3_penalty_hp", "ch3_adaptive_bem"]
+LONGEST_FIRST = ["ch4_plasticity", "ch4_section44", "ch2_convergence", "ch4_mortar",
+                 "ch4_adaptive_fefe", "ch3_penalty_hp", "ch3_adaptive_bem"]
 
 
 def priority_of(name):

@@ -38,13 +38,22 @@ class LoadSteps:
     LU_CACHE_NNZ = 100_000_000
 
     def __init__(self, pr, f_ext, fixed_dofs, fixed_values, merit, initial,
-                 lu_ordering: str = "COLAMD"):
+                 lu_ordering: str = "COLAMD", linear_solver: str = "lu"):
         if merit not in MERITS:
             raise ValueError(f"merit must be one of {MERITS}, got {merit!r}")
         if lu_ordering not in LU_ORDERINGS:
             raise ValueError(f"lu_ordering must be one of {LU_ORDERINGS}, got "
                              f"{lu_ordering!r}")
         self.lu_ordering = lu_ordering
+        if linear_solver not in LINEAR_SOLVERS:
+            raise ValueError(f"linear_solver must be one of {LINEAR_SOLVERS}, got "
+                             f"{linear_solver!r}")
+        if linear_solver == "woodbury" and (pr.dense or pr.exact is not None or not all(
+                getattr(b, "linear", False) for b in pr.bodies.values())):
+            raise ValueError("linear_solver='woodbury' needs linear bodies, an FE body "
+                             "(sparse system) and the fixed (gauss) contact points")
+        self.linear_solver = linear_solver
+        self._woodbury = None
         if merit == "energy" and not all(getattr(b, "linear", False)
                                           for b in pr.bodies.values()):
             raise ValueError("merit='energy' needs linear bodies (a plastic body has no "
@@ -215,7 +224,26 @@ class LoadSteps:
         return lu
 
     def step(self, it: Iterate) -> np.ndarray:
+        if self.linear_solver == "woodbury":
+            law, w = it.data["law"], it.data["weights"]
+            return self._solve_woodbury(it.data, w * law.dp_n, w * law.dt_t,
+                                        w * law.dt_n, -it.residual)
         return self._solve(self.pr.tangent(it.data), -it.residual)
+
+    def _solve_woodbury(self, cs, wn, wt, wtn, r: np.ndarray) -> np.ndarray:
+        """The Newton system K + C on the free dofs by :class:`WoodburySolver` (K
+        factorised once per load path), with the residual check of :meth:`_solve`."""
+        wb = self._woodbury
+        if wb is None or wb.K is not cs["K_body"]:
+            wb = self._woodbury = WoodburySolver(cs["K_body"], self.free, self.pr.offset,
+                                                 self.pr.Gn, self.pr.Gt)
+        d = wb.solve(wn, wt, wtn, r)
+        if not np.all(np.isfinite(d)) or \
+                np.linalg.norm(wb.matvec(wn, wt, wtn, d) - r) > 1e-6 * np.linalg.norm(r):
+            raise SingularStep("singular Newton matrix (body not fixed?)")
+        dx = np.zeros(self.pr.ndofs)
+        dx[self.free] = d
+        return dx
 
     def bonded_predictor(self, it: Iterate):
         """The bonded solution (every point in contact and sticking, relative to the
@@ -229,6 +257,13 @@ class LoadSteps:
         rel = cs["g_t"] - self.slip
         Rb = cs["f_body"] - self.f + Gn.T @ (w * -pen / pr.eps_n) \
             + Gt.T @ (w * rel / pr.eps_t)
+        if self.linear_solver == "woodbury":
+            try:
+                return it.x + self._solve_woodbury(cs, w * ones / pr.eps_n,
+                                                   w * ones / pr.eps_t, 0.0 * w,
+                                                   -Rb[self.free])
+            except SingularStep:
+                return None
         C = Gn.T @ sp.diags(w * ones / pr.eps_n) @ Gn \
             + Gt.T @ sp.diags(w * ones / pr.eps_t) @ Gt
         K = cs["K_body"]
@@ -286,3 +321,150 @@ def _ordered_splu(pr, Af: sp.csc_matrix, pattern):
     while len(orders) > ORDER_CACHE:
         orders.pop(next(iter(orders)))
     return lu
+
+
+#: Newton solvers of a system with an FE body (:meth:`LoadSteps._solve`): "lu" a sparse
+#: LU of every Newton matrix; "woodbury" one factorisation of the bodies' stiffness per
+#: problem and the contact terms by the Sherman-Morrison-Woodbury formula (linear bodies)
+LINEAR_SOLVERS = ("lu", "woodbury")
+
+
+class WoodburySolver:
+    """Newton systems (K + C) d = r of linear bodies on the free dofs, C = B^T M B the
+    linearised contact terms of Section 4.2.5 (B = [G_n; G_t] on the points where the
+    law has a derivative, M = [[W_n, 0], [-W_tn, W_t]]), by
+
+        (K + B^T M B)^{-1} = K^{-1} - K^{-1} B^T (I + M B K^{-1} B^T)^{-1} M B K^{-1}
+
+    (Sherman-Morrison-Woodbury, push-through form: M may be singular, e.g. W_t = 0 on
+    slipping points).  K = blockdiag(K^s, K^m) is factorised once per body (sparse LU
+    with diagonal pivots: K is symmetric positive definite on the free dofs of a body
+    held by Dirichlet conditions), its unknowns ordered by minimum degree on K with the
+    contact dofs c (all dofs a contact point touches) last, so that the trailing block
+    of the factors is the Schur complement S = K_cc - K_ci K_ii^{-1} K_ic and
+    B K^{-1} B^T = B_c S^{-1} B_c^T needs no solves.  A Newton step costs two solves
+    with K and a dense system of twice the number of active points: the same Newton
+    steps as a sparse LU of K + C, up to round-off.  ``K`` the body tangent on all
+    dofs, ``free`` the free dofs, ``offset`` the first master dof, ``Gn``, ``Gt`` the
+    maps U -> dg_n, dg_t at all contact points."""
+
+    #: the dense (K^{-1})_cc has this many rows at most (8e3: 0.5 GB)
+    MAX_CONTACT_DOFS = 8000
+
+    def __init__(self, K, free: np.ndarray, offset: int, Gn, Gt):
+        self.K = K
+        Kf = sp.csr_matrix(K)[free][:, free].tocsc()
+        self.Kf = Kf
+        self.n = free.size
+        self.Gn, self.Gt = (sp.csr_matrix(G)[:, free] for G in (Gn, Gt))
+        # the contact dofs: all dofs touched by a contact point (free numbering)
+        self.rows = np.unique(np.concatenate([self.Gn.indices, self.Gt.indices]))
+        if self.rows.size > self.MAX_CONTACT_DOFS:
+            raise ValueError(f"{self.rows.size} contact dofs: too many for the dense "
+                             f"(K^-1)_cc (at most {self.MAX_CONTACT_DOFS}); use "
+                             "linear_solver='lu'")
+        self.row_pos = np.full(self.n, -1, dtype=np.int64)
+        self.row_pos[self.rows] = np.arange(self.rows.size)
+        self.from_factors = []       # per body: (K^-1)_cc from the factors (else solves)
+        # the body blocks of K on the free dofs (no coupling between the bodies in K)
+        split = int(np.searchsorted(free, offset))
+        if 0 < split < self.n and (Kf[:split][:, split:].count_nonzero() or
+                                   Kf[split:][:, :split].count_nonzero()):
+            raise ValueError("K couples the bodies: no factorisation body by body")
+        self.kinv_cc = np.zeros((self.rows.size, self.rows.size))
+        self.blocks = []
+        for lo, hi in ((0, split), (split, self.n)):
+            if hi > lo:
+                self.blocks.append(self._factor_block(Kf[lo:hi][:, lo:hi].tocsc(), lo, hi))
+
+    def _factor_block(self, Kb, lo: int, hi: int):
+        """(slice, permutation p, LU of Kb[p][:, p] or None if singular) of one body;
+        fills this body's block of (K^{-1})_cc."""
+        c = self.rows[(self.rows >= lo) & (self.rows < hi)] - lo
+        n = hi - lo
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", spla.MatrixRankWarning)
+            try:
+                # the minimum degree order of Kb (an incomplete LU that drops every
+                # entry returns it at the cost of the ordering)
+                seq = np.argsort(spla.spilu(Kb, drop_tol=1e300, fill_factor=1,
+                                            permc_spec="MMD_AT_PLUS_A",
+                                            diag_pivot_thresh=0.0,
+                                            options=dict(SymmetricMode=True)).perm_c)
+                is_c = np.zeros(n, dtype=bool)
+                is_c[c] = True
+                p = np.concatenate([seq[~is_c[seq]], c])
+                Kp = Kb[p][:, p].tocsc()
+                Kp.sort_indices()
+                lu = spla.splu(Kp, permc_spec="NATURAL", diag_pivot_thresh=0.0,
+                               options=dict(SymmetricMode=True))
+            except RuntimeError:
+                return slice(lo, hi), None, None
+        pos = self.row_pos[c + lo]
+        self.kinv_cc[np.ix_(pos, pos)] = self._kinv_trailing(lu, n, c.size)
+        return slice(lo, hi), p, lu
+
+    def _kinv_trailing(self, lu, n: int, m: int) -> np.ndarray:
+        """(Kp^{-1}) on the last m unknowns: the inverse of the Schur complement, the
+        trailing block L_tt U_tt of the factors when SuperLU kept those unknowns last
+        (its elimination-tree postorder may move them; then m solves)."""
+        t = n - m
+        trailing = bool(np.all(lu.perm_c[t:] >= t) and np.all(lu.perm_r[t:] >= t))
+        self.from_factors.append(trailing)
+        if m == 0:
+            return np.zeros((0, 0))
+        if trailing:
+            L = lu.L[:, t:].tocsr()[t:].toarray()
+            U = lu.U[:, t:].tocsr()[t:].toarray()
+            T = L @ U                       # LU[perm_r[j], perm_c[k]] = Kp[j, k]
+            S = T[np.ix_(lu.perm_r[t:] - t, lu.perm_c[t:] - t)]
+            return sla.inv(S)
+        E = np.zeros((n, m))
+        E[t + np.arange(m), np.arange(m)] = 1.0
+        return lu.solve(E)[t:]
+
+    def _kinv(self, R: np.ndarray) -> np.ndarray:
+        """K^{-1} R (R: (n,) or (n, k)), body by body."""
+        out = np.empty_like(R)
+        for sl, p, lu in self.blocks:
+            if lu is None:
+                raise SingularStep("singular body stiffness (a body not held by Dirichlet "
+                                   "conditions?): use linear_solver='lu'")
+            out[sl][p] = lu.solve(np.ascontiguousarray(R[sl][p]))
+        return out
+
+    def _columns(self, dofs: np.ndarray) -> np.ndarray:
+        """(K^{-1})[dofs, dofs] (``dofs`` among the contact dofs)."""
+        pos = self.row_pos[dofs]
+        return self.kinv_cc[np.ix_(pos, pos)]
+
+    def solve(self, wn: np.ndarray, wt: np.ndarray, wtn: np.ndarray,
+              r: np.ndarray) -> np.ndarray:
+        """d with (K + Gn^T W_n Gn + Gt^T (W_t Gt - W_tn Gn)) d = r on the free dofs,
+        W = diag(wn), diag(wt), diag(wtn) (the law derivatives times the weights)."""
+        act = np.flatnonzero((wn != 0) | (wt != 0) | (wtn != 0))
+        y = self._kinv(r)
+        if act.size == 0:
+            return y
+        m = act.size
+        B = sp.vstack([self.Gn[act], self.Gt[act]]).tocsc()
+        dofs = np.flatnonzero(np.diff(B.indptr))
+        Bd = B[:, dofs].toarray()
+        H = Bd @ self._columns(dofs) @ Bd.T
+        M = np.zeros((2 * m, 2 * m))
+        i = np.arange(m)
+        M[i, i] = wn[act]
+        M[m + i, i] = -wtn[act]
+        M[m + i, m + i] = wt[act]
+        try:
+            s = sla.solve(np.eye(2 * m) + M @ H, M @ (B @ y))
+        except (np.linalg.LinAlgError, ValueError):
+            raise SingularStep("singular Newton matrix (contact update of the "
+                               "Woodbury formula)") from None
+        return y - self._kinv(B.T @ s)
+
+    def matvec(self, wn, wt, wtn, d: np.ndarray) -> np.ndarray:
+        """(K + C) d on the free dofs (the residual check of a solve)."""
+        gn, gt = self.Gn @ d, self.Gt @ d
+        return self.Kf @ d + self.Gn.T @ (wn * gn) + self.Gt.T @ (wt * gt - wtn * gn)
+

@@ -145,6 +145,20 @@ def _trace_maps(nm, sides, ndofs):
     return Gn, Gt, tm
 
 
+def _csr_block_diag(A: sp.csr_matrix, B: sp.csr_matrix) -> sp.csr_matrix:
+    """blockdiag(A, B) in CSR: the rows of A, then those of B with shifted columns (the
+    entries of ``sp.block_diag``, without its COO round trip; entries in the order of
+    the blocks)."""
+    n, m = A.shape
+    idx = np.result_type(A.indices, B.indices, np.int32)
+    if m + B.shape[1] > np.iinfo(idx).max or A.nnz + B.nnz > np.iinfo(idx).max:
+        idx = np.int64
+    indptr = np.concatenate([A.indptr.astype(idx), A.nnz + B.indptr[1:].astype(idx)])
+    indices = np.concatenate([A.indices.astype(idx), B.indices.astype(idx) + m])
+    data = np.concatenate([A.data, B.data]).astype(np.result_type(A.data, B.data))
+    return sp.csr_matrix((data, indices, indptr), shape=(n + B.shape[0], m + B.shape[1]))
+
+
 class _State(dict):
     """The contact state of :meth:`TwoBodyContact.internal_force`: a dict whose entries
     in ``lazy`` (key -> callable) are computed on first access."""
@@ -525,7 +539,7 @@ class TwoBodyContact:
         elif self.dense:
             out = sla.block_diag(Ks, Km)
         else:
-            out = sp.block_diag([sp.csr_matrix(Ks), sp.csr_matrix(Km)], format="csr")
+            out = _csr_block_diag(sp.csr_matrix(Ks), sp.csr_matrix(Km))
         self._blocks_last = (Ks, Km, out)
         return out
 
@@ -564,7 +578,7 @@ class TwoBodyContact:
               merit: str = "residual", predictor: bool = False,
               roundoff_stop: bool = False,
               initial: ContactResult | None = None,
-              lu_ordering: str = "COLAMD") -> ContactResult:
+              lu_ordering: str = "COLAMD", linear_solver: str = "lu") -> ContactResult:
         """Incremental loading with semismooth Newton (Algorithm 4.1,
         :func:`hpfebe.nonlinear.load_path`).
 
@@ -587,9 +601,15 @@ class TwoBodyContact:
         load and obstacle motion ramped from its final values).  ``lu_ordering``: the
         column ordering of the sparse LU of a system with an FE body
         (:data:`hpfebe.contact.loading.LU_ORDERINGS`: "COLAMD", SuperLU's default, or
-        "MMD_AT_PLUS_A", faster, other round-off)."""
+        "MMD_AT_PLUS_A", faster, other round-off).  ``linear_solver``
+        (:data:`hpfebe.contact.loading.LINEAR_SOLVERS`): "lu", a sparse LU of every
+        Newton matrix, or for linear bodies with an FE body "woodbury", one
+        factorisation of the bodies' stiffness for the whole load path and the contact
+        terms by the Sherman-Morrison-Woodbury formula on the active points
+        (:class:`hpfebe.contact.loading.WoodburySolver`: the same Newton steps up to
+        round-off; measured 7x less CPU on 83,076 dofs with 640 contact points)."""
         steps = LoadSteps(self, f_ext, fixed_dofs, fixed_values, merit, initial,
-                          lu_ordering)
+                          lu_ordering, linear_solver)
         lf = np.asarray(load_factors, dtype=float).ravel()
         if lf.size == 0 or not np.all(np.isfinite(lf)):
             raise ValueError(f"load_factors must be a non-empty finite sequence, got {load_factors!r}")

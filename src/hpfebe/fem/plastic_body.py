@@ -270,8 +270,11 @@ class ElastoPlasticFE:
         d = 1e-9 * float(np.ptp(self.mesh.p, axis=1).max())
         off = np.array([[d, d], [d, -d], [-d, d], [-d, -d]])
         x, y = p[0] + off[:, 0], p[1] + off[:, 1]
+        finder = self.__dict__.get("_finder")
+        if finder is None:          # built once per body (the same finder every call)
+            finder = self._finder = self.mesh.element_finder()
         try:
-            e = np.asarray(self.mesh.element_finder()(x, y))
+            e = np.asarray(finder(x, y))
         except ValueError:
             e = np.array([-1])
         e = np.unique(e[e >= 0])
