@@ -1,0 +1,51 @@
+"""Issue 14, small N: V + K + W of the Laplace operators at p = 1 (unit square, one
+thread) by the closed forms of hpfebe.bem.lowest_order against the general quadrature
+path (``closed_form=False``), minima of interleaved runs.  Skipped by default; run with
+
+    NUMBA_NUM_THREADS=1 pytest tests/benchmarks/test_bench_lowest_order.py --benchmark-only
+
+The peer comparison (HILBERT's C++ port) is benchmarks/peers/run_peers.py.
+"""
+
+from __future__ import annotations
+
+import time
+
+import numba
+import numpy as np
+import pytest
+
+from hpfebe import BoundaryMesh
+from hpfebe.bem import LaplaceBEM
+
+SQUARE = [(0, 0), (1, 0), (1, 1), (0, 1)]
+
+
+def _vkw(mesh, closed_form):
+    op = LaplaceBEM(mesh, closed_form=closed_form)
+    return op.V, op.K, op.W
+
+
+@pytest.mark.parametrize("N", [16, 64, 256, 1024])
+def test_closed_form_vs_general(benchmark, N):
+    """Closed form / general path time of V + K + W (recorded; asserted only that the
+    closed form is faster)."""
+    old = numba.get_num_threads()
+    numba.set_num_threads(1)
+    try:
+        mesh = BoundaryMesh.polygon(SQUARE, n=N // 4, p=1)
+        small = BoundaryMesh.polygon(SQUARE, n=2, p=1)
+        _vkw(small, True)
+        _vkw(small, False)
+        best = {True: np.inf, False: np.inf}
+        for _ in range(max(3, 1024 // N)):
+            for cf in (True, False):
+                t = time.perf_counter()
+                _vkw(mesh, cf)
+                best[cf] = min(best[cf], time.perf_counter() - t)
+    finally:
+        numba.set_num_threads(old)
+    benchmark.extra_info.update(N=N, closed_ms=1e3 * best[True], general_ms=1e3 * best[False],
+                                ratio=best[True] / best[False])
+    benchmark.pedantic(lambda: None, rounds=1, iterations=1)
+    assert best[True] < best[False], best
