@@ -2,9 +2,13 @@
 
 Runs the scene in a fresh Python process with an empty, temporary NUMBA_CACHE_DIR and
 records numba's "numba:compile" events (numba.core.event): one line per compiled
-(function, signature), its own time (nested compiles subtracted), and the wall time of
-each step of the scene.  A second process with the same (now warm) cache gives the
-warm-start times.
+(function, signature), its own time (nested compiles subtracted), split into LLVM
+(numba's "numba:llvm_lock" events: optimisation and machine code of the function's
+library, which holds a copy of every jitted callee it calls) and the rest (numba's Python
+front end: bytecode analysis, type inference, lowering to LLVM IR), and the wall and CPU
+time of each step of the scene.  A second process with the same (now warm) cache gives
+the warm-start times.  Run-to-run noise on a shared machine is +-10 % or more: compare
+CPU totals of interleaved runs.
 
     python tools/compile_time.py            # first LaplaceBEM(mesh).V, LameBEM(...).S_hat
     python tools/compile_time.py --top 40   # more lines
@@ -26,16 +30,17 @@ import textwrap
 
 SCENE = textwrap.dedent("""
     import json, sys, time
-    t0 = time.perf_counter()
+    t0, c0 = time.perf_counter(), time.process_time()
     import numba.core.event as ev
     records = []
-    stack = []
+    stack = []      # per open compile: [start, nested compile time, own LLVM time]
+    llvm = []
 
     class L(ev.Listener):
         def on_start(self, event):
-            stack.append([time.perf_counter(), 0.0])
+            stack.append([time.perf_counter(), 0.0, 0.0])
         def on_end(self, event):
-            t_start, child = stack.pop()
+            t_start, child, own_llvm = stack.pop()
             total = time.perf_counter() - t_start
             if stack:
                 stack[-1][1] += total
@@ -43,17 +48,29 @@ SCENE = textwrap.dedent("""
             f = getattr(d, "py_func", None)
             records.append(dict(name=(f.__module__ + "." + f.__qualname__) if f else str(d),
                                 sig=str(event.data["args"]), self_s=total - child,
-                                total_s=total))
+                                llvm_s=own_llvm, total_s=total))
+
+    class LL(ev.Listener):
+        def on_start(self, event):
+            llvm.append(time.perf_counter())
+        def on_end(self, event):
+            t = time.perf_counter() - llvm.pop()
+            if stack:
+                stack[-1][2] += t
 
     ev.register("numba:compile", L())
+    ev.register("numba:llvm_lock", LL())
     from hpfebe import BoundaryMesh
     from hpfebe.bem import LameBEM, LaplaceBEM
     steps = {"import": time.perf_counter() - t0}
+    cpu = {"import": time.process_time() - c0}
     mesh = BoundaryMesh.polygon([(0, 0), (1, 0), (1, 1), (0, 1)], n=2, p=1)
-    t = time.perf_counter(); LaplaceBEM(mesh).V; steps["LaplaceBEM.V"] = time.perf_counter() - t
-    t = time.perf_counter(); LameBEM(mesh, 1.0, 0.3).S_hat
-    steps["LameBEM.S_hat"] = time.perf_counter() - t
-    print(json.dumps(dict(steps=steps, records=records)))
+    for name, f in (("LaplaceBEM.V", lambda: LaplaceBEM(mesh).V),
+                    ("LameBEM.S_hat", lambda: LameBEM(mesh, 1.0, 0.3).S_hat)):
+        t, c = time.perf_counter(), time.process_time()
+        f()
+        steps[name], cpu[name] = time.perf_counter() - t, time.process_time() - c
+    print(json.dumps(dict(steps=steps, cpu=cpu, records=records)))
 """)
 
 
@@ -80,17 +97,19 @@ def main(argv=None) -> None:
     for label, res in (("cold (empty cache)", cold), ("warm (cached)", warm)):
         s = res["steps"]
         print(f"{label}: " + ", ".join(f"{k} {v:.2f} s" for k, v in s.items())
-              + f"; total {sum(s.values()):.2f} s")
+              + f"; total {sum(s.values()):.2f} s (CPU {sum(res['cpu'].values()):.2f} s)")
     recs = sorted(cold["records"], key=lambda r: -r["self_s"])
     per_fn: dict[str, list] = {}
     for r in recs:
         per_fn.setdefault(r["name"], []).append(r)
-    print(f"\n{len(recs)} compilations of {len(per_fn)} functions, "
-          f"{sum(r['self_s'] for r in recs):.2f} s in all (self time)")
-    print(f"{'self s':>7} {'#sig':>4}  function")
+    tot, tot_llvm = sum(r["self_s"] for r in recs), sum(r["llvm_s"] for r in recs)
+    print(f"\n{len(recs)} compilations of {len(per_fn)} functions, {tot:.2f} s in all "
+          f"(self time; LLVM {tot_llvm:.2f} s, front end {tot - tot_llvm:.2f} s)")
+    print(f"{'self s':>7} {'LLVM s':>7} {'front s':>7} {'#sig':>4}  function")
     rows = sorted(per_fn.items(), key=lambda kv: -sum(r["self_s"] for r in kv[1]))
     for name, rs in rows[:args.top]:
-        print(f"{sum(r['self_s'] for r in rs):7.2f} {len(rs):4d}  {name}")
+        s_, l_ = sum(r["self_s"] for r in rs), sum(r["llvm_s"] for r in rs)
+        print(f"{s_:7.2f} {l_:7.2f} {s_ - l_:7.2f} {len(rs):4d}  {name}")
     if args.sigs:
         for name, rs in rows:
             if len(rs) > 1 and name.startswith("hpfebe"):

@@ -31,8 +31,12 @@ def _bem(steps: dict) -> None:
     steps["geometry"] = time.perf_counter() - t
 
     t = time.perf_counter()
-    lap = LaplaceBEM(mesh)
+    lap = LaplaceBEM(mesh)      # p = 1: the closed forms (hpfebe.bem.lowest_order)
     lap.V, lap.K, lap.W
+    from .bem.lowest_order import _gather    # the threaded closed form's second pass
+
+    _gather(np.zeros((1, 2)), np.zeros((1, 2), np.int64), np.zeros(1, np.int64),
+            np.zeros((1, 1)), np.arange(1))
     U = np.ones(lap.V_space.ndof)
     pts = np.column_stack([np.linspace(0.2, 0.8, 64), np.full(64, 0.5)])  # tabulated path
     lap.representation(pts, U, lap.Psi(U))

@@ -5,30 +5,35 @@ One routine, :func:`assemble`, serves every operator: it is specialised by the k
 spaces.  Each pair of elements is classified (coincident / adjacent / far),
 integrated by the matching function of :mod:`hpfebe.bem.integration` into a local block,
 and scattered.  Rows belong to test elements, so the loop over test elements runs in
-parallel without write conflicts (the test space must be discontinuous: W_hp): a numba
-parallel loop over chunks of rows (the mirror of the upper triangle and the
-sandwich W = T^T V T run as ``nogil`` kernels on Python threads: no parfor to compile).
-With one row chunk (one numba thread, as in every Snakemake job, or a mesh too small to
-pay for threads) the same loop runs as a plain compilation, ``_assemble_rows_serial``,
-and the parfor is compiled only if a process needs it (numba compiles at the first
-call): 5-8 s of a cold start instead of 20-30 s.
+parallel without write conflicts (the test space must be discontinuous: W_hp): chunks
+of rows of the one compiled row loop, ``_assemble_rows_serial`` (``nogil``), taken by
+numba.get_num_threads() Python threads as they become free; with one thread (every
+Snakemake job) or a mesh too small to pay for threads, one direct call.  The mirror of
+the upper triangle, the sandwich W = T^T V T and the finiteness check run the same way.
+(Issue 14: this replaced a numba parfor over static row chunks - the same 2-thread wall
+time at N = 1024 and 4096 on a quiet machine, but compiling the parfor cost a 2-thread
+process ~9 s of a cold start; the serial steps the threads now share were 3 % of V + K + W
+at N = 4096, the sandwich's page faults 0.3 s in one task.)
 
 Caching: numba's on-disk cache keys a function on the contents of its own file only, so
-the cached ``_assemble_rows`` keeps the machine code of the :mod:`.integration` and
+the cached ``_assemble_rows_serial`` keeps the machine code of the :mod:`.integration` and
 :mod:`.kernels` functions it was compiled with.  After changing those files, delete
 ``src/hpfebe/bem/__pycache__`` (or point NUMBA_CACHE_DIR elsewhere), or the old code runs.
 """
 
 from __future__ import annotations
 
+import gc
 import math
+import threading
 import types
 from concurrent.futures import ThreadPoolExecutor
+from contextlib import contextmanager
 from functools import lru_cache
 
 import numba
 import numpy as np
-from numba import njit, prange
+from numba import njit
 
 from ..quadrature import rule_tables
 from ..spaces import P_MAX, DiscontinuousSpace, eval_basis, gll_tables, n_local
@@ -88,29 +93,27 @@ def _scatter(blk, dofs_i, dofs_j, mt, mr, d, out):
                     out[gk * d + c1, gl * d + c2] += blk[k * d + c1, l * d + c2]
 
 
-_FUSE_DL = True     # see _rows; each compilation sets its own
+_FUSE_DL = True     # see _rows
 
 
 def _rows(kernel, logc, haslog, kp, d, nodes, elements, normals, L, mid,
           kt, degt, dofs_t, kr, degr, dofs_r, symmetric,
           gx, gw, lx, lw, gll_x, gll_b, tab_t, tab_r, thr, out, rows, starts):
     """Rows of the test elements ``rows`` (pairs j >= i only if ``symmetric``) into out,
-    in chunks rows[starts[c]:starts[c+1]] run in parallel, each with its own scratch
-    arrays (allocated once per chunk, not per row: the small-N overhead).  Rows belong to
-    test elements, so chunks never write the same entry.
+    in chunks rows[starts[c]:starts[c+1]], each with its own scratch arrays (allocated
+    once per chunk, not per row: the small-N overhead).  Rows belong to test elements,
+    so calls on disjoint rows never write the same entry (threads: :func:`assemble`).
 
-    Compiled twice (see ``_assemble_rows`` below): as a parfor, and without
-    ``parallel=True`` for one thread.  The parfor body gets ``noalias`` array
-    arguments, which a plain ``@njit`` function cannot request, so loops that are only
-    fast with noalias (LLVM vectorises them) differ between the two through the
-    compile-time constant ``_FUSE_DL``; the serial one keeps its values in scalars.
-    Measured (issue 14, one thread, CPU time, N = 64 ... 4096, p = 1): serial V 0.97-1.05x
-    and K 0.94-0.97x of the parfor's time, both 0.56-0.83x of the parfor before."""
+    Compiled as ``_assemble_rows_serial`` (a plain, ``nogil`` compilation).  The
+    compile-time constant ``_FUSE_DL`` selects the fused Laplace double-layer fast path
+    below; it was False in the former parfor compilation, whose ``noalias`` arguments
+    vectorised the unfused loop instead (issue 14: serial V 0.97-1.05x and K 0.94-0.97x
+    of the parfor's time on one thread, N = 64 ... 4096, p = 1)."""
     ne = elements.shape[0]
     nmax = gx.shape[0] - 1
     ntab = tab_t.shape[1] - 1
     pmax = max(degt.max(), degr.max()) + 1
-    for ch in prange(starts.shape[0] - 1):
+    for ch in range(starts.shape[0] - 1):
         phi, psi, Phi, Psi, Kq, tmp, rxs, rys, wx, ww, stack = _scratch(nmax, pmax, d)
         blk = np.empty((pmax * d, pmax * d))
         for idx in range(starts[ch], starts[ch + 1]):
@@ -270,13 +273,8 @@ def _renamed(fn, name: str, **constants):
     return g
 
 
-# one source, two compilations (numba compiles a dispatcher at its first call, so the one
-# a process never calls costs nothing): the parfor for several row chunks on several
-# threads, and a plain loop (prange is range without parallel=True) for one chunk - the
-# single-thread case of every Snakemake job and test process, whose parfor compile was
-# 20 s of a cold start (issue 14)
-_assemble_rows = njit(cache=True, parallel=True)(
-    _renamed(_rows, "_assemble_rows", _FUSE_DL=False))
+# the row loop, compiled once (the name of the former single-thread variant, beside a
+# parfor ``_assemble_rows`` that issue 14 removed; run on Python threads by assemble)
 _assemble_rows_serial = njit(cache=True, nogil=True)(
     _renamed(_rows, "_assemble_rows_serial", _FUSE_DL=True))
 
@@ -297,34 +295,58 @@ def _mirror_rows(A, blocks):
 MIN_PAIRS_PER_THREAD = 4096   # below this many element pairs one thread is faster
 
 
-def _chunk_starts(n: int, work: float) -> np.ndarray:
-    """Boundaries of the row chunks of the parallel loop: one chunk when ``work`` (element
-    pairs) is too small to pay for threads, else 4 per thread."""
-    nt = numba.get_num_threads()
-    if nt <= 1 or work < MIN_PAIRS_PER_THREAD * nt:
-        return np.array([0, n], dtype=np.int64)
-    return np.linspace(0, n, min(n, 4 * nt) + 1).round().astype(np.int64)
-
-
 def _interleaved(n: int) -> np.ndarray:
     """0, n-1, 1, n-2, ...: short and long rows of a triangle alternate (load balance)."""
     idx = np.arange(n)
     return np.where(idx % 2 == 0, idx // 2, n - 1 - idx // 2)
 
 
-def _threaded(fn, args, items: np.ndarray, work: float) -> None:
+def _n_threads(work: float) -> int:
+    """Threads for ``work`` element pairs: numba.get_num_threads(), or 1 if the work is
+    too small to pay for threads (below MIN_PAIRS_PER_THREAD per thread)."""
+    nt = numba.get_num_threads()
+    return 1 if nt <= 1 or work < MIN_PAIRS_PER_THREAD * nt else nt
+
+
+def _threaded(fn, args, items: np.ndarray, work: float, per_thread: int = 4) -> None:
     """fn(*args, chunk) over chunks of ``items`` on numba.get_num_threads() threads (the
     nogil kernels write disjoint rows); one direct call when ``work`` (element pairs) is
-    too small to pay for threads.  NUMBA_NUM_THREADS / numba.set_num_threads pin it."""
-    nt = min(numba.get_num_threads(), len(items))
-    if nt <= 1 or work < MIN_PAIRS_PER_THREAD * nt:
+    too small to pay for threads.  NUMBA_NUM_THREADS / numba.set_num_threads pin it.
+    ``per_thread`` chunks per thread, each a run of ``items``, taken by the threads as
+    they become free (dynamic: rows of uneven cost balance)."""
+    nt = min(_n_threads(work), len(items))
+    if nt <= 1:
         fn(*args, items)
         return
-    # 4 chunks per thread taken dynamically, each a run of the interleaved order
-    chunks = np.array_split(items, 4 * nt)
+    chunks = np.array_split(items, min(len(items), per_thread * nt))
     with ThreadPoolExecutor(max_workers=nt) as pool:
         for f in [pool.submit(fn, *args, c) for c in chunks]:
             f.result()
+
+
+ROW_CHUNKS_PER_THREAD = 8   # row chunks per thread (taken dynamically) in assemble
+
+
+def _rows_chunk(args, out, rows):
+    """The row loop on the rows ``rows`` (one chunk): a task of :func:`_threaded`."""
+    _assemble_rows_serial(*args, out, rows, np.array([0, len(rows)], dtype=np.int64))
+
+
+def _rows_finite(A: np.ndarray, lo: int, hi: int) -> bool:
+    """Whether the rows lo <= r < hi of A are all finite (numpy releases the GIL)."""
+    return bool(np.isfinite(A[lo:hi]).all())
+
+
+def _all_finite(A: np.ndarray) -> bool:
+    """np.all(np.isfinite(A)) for a dense matrix, in row blocks on the threads (as a
+    serial step it was 3 % of V + K + W at N = 4096 on 2 threads, issue 14)."""
+    nt = _n_threads(A.size / 64)
+    n = A.shape[0]
+    if nt <= 1:
+        return _rows_finite(A, 0, n)
+    cuts = np.linspace(0, n, nt + 1).round().astype(np.int64)
+    with ThreadPoolExecutor(max_workers=nt) as pool:
+        return all(pool.map(_rows_finite, [A] * nt, cuts[:-1], cuts[1:]))
 
 
 def _mirror_upper(A: np.ndarray) -> None:
@@ -401,6 +423,39 @@ def _element_geometry(nodes, elements):
     return normals, L, mid
 
 
+COMPILE_GC_THRESHOLD = (10000, 50, 100)   # gc thresholds while numba compiles the kernels
+
+
+@contextmanager
+def _first_call(dispatcher):
+    """Around the first call of ``dispatcher`` in a process (numba compiles it, or loads it
+    from its cache): Python's cyclic GC with larger thresholds (COMPILE_GC_THRESHOLD),
+    restored after.  numba's compiler allocates ~10^6 short-lived cyclic objects, and with
+    the default thresholds (700, 10, 10) the repeated full collections were 12 % of a cold
+    start (issue 14: first LaplaceBEM.V + LameBEM.S_hat 13.8 -> 12.0 s CPU with the GC
+    off, -1.2 s with these thresholds in interleaved runs, +40 MB peak memory).  The
+    thresholds are per process: nested or concurrent entries share one save/restore."""
+    if dispatcher.signatures:
+        yield
+        return
+    with _GC_LOCK:
+        if _GC_STATE["depth"] == 0:
+            _GC_STATE["saved"] = gc.get_threshold()
+            gc.set_threshold(*COMPILE_GC_THRESHOLD)
+        _GC_STATE["depth"] += 1
+    try:
+        yield
+    finally:
+        with _GC_LOCK:
+            _GC_STATE["depth"] -= 1
+            if _GC_STATE["depth"] == 0:
+                gc.set_threshold(*_GC_STATE["saved"])
+
+
+_GC_LOCK = threading.Lock()
+_GC_STATE = {"depth": 0, "saved": None}
+
+
 def _space_arrays(space):
     # local functions per element: n_local(kind, p_I) with p_I the element degree
     return space.kind, np.ascontiguousarray(space.mesh.degrees), space.elem_dofs
@@ -434,26 +489,35 @@ def assemble(kernel: int, logc, kp, test, trial, d: int = 1,
     kr, degr, dofs_r = _space_arrays(trial)
     out = np.zeros((test.ndof * d, trial.ndof * d))
     nodes, elements = mesh.nodes, mesh.elements
-    normals, L, mid = _element_geometry(nodes, elements)
+    with _first_call(_element_geometry):
+        normals, L, mid = _element_geometry(nodes, elements)
     ne = elements.shape[0]
     args = (kernel, logc, bool(logc.any()), kp, d, nodes, elements, normals, L, mid,
             kt, degt, dofs_t, kr, degr, dofs_r, symmetric, gx, gw, lx, lw, gll_x, gll_b,
             _far_tables(kt, pmax), _far_tables(kr, pmax), _order_thresholds(pmax))
-    starts = _chunk_starts(ne, ne * ne * (0.5 if symmetric else 1.0))
-    if len(starts) == 2:
-        # one chunk (one thread, or too little work for threads): the serial compilation
-        # (the order of the rows does not change a bit of the result: each row is one
-        # test element's, summed over j in order)
-        _assemble_rows_serial(*args, out, np.arange(ne), starts)
+    # rows in chunks (ROW_CHUNKS_PER_THREAD per thread, the interleaved order balancing
+    # the triangle of a symmetric matrix) on Python threads, each chunk one call of the
+    # nogil row loop, taken by the threads as they become free.  One thread: one direct
+    # call (numba compiling it from inside _threaded's frames took 1.6 s more CPU time
+    # of a cold start, measured repeatedly, cause unknown).  The order of the rows does
+    # not change a bit of the result: each row is one test element's, summed over j.
+    work = ne * ne * (0.5 if symmetric else 1.0)
+    if _n_threads(work) <= 1:
+        with _first_call(_assemble_rows_serial):
+            _assemble_rows_serial(*args, out, np.arange(ne),
+                                  np.array([0, ne], dtype=np.int64))
         if symmetric:
             _mirror_rows(out, np.arange((out.shape[0] + 63) // 64))
     else:
-        _assemble_rows(*args, out, _interleaved(ne), starts)
+        with _first_call(_assemble_rows_serial):      # (gc thresholds: per process)
+            _threaded(_rows_chunk, (args, out),
+                      _interleaved(ne) if symmetric else np.arange(ne), work,
+                      per_thread=ROW_CHUNKS_PER_THREAD)
         if symmetric:
             # dofs of W_hp grow with the element index, so the pairs j >= i filled the
             # upper triangle
             _mirror_upper(out)
-    if not np.all(np.isfinite(out)):
+    if not _all_finite(out):
         raise FloatingPointError("assembly produced non-finite entries "
                                  "(degenerate geometry or degree too high?)")
     return out
@@ -499,8 +563,12 @@ def local_block(kernel, logc, kp, mesh, i: int, j: int, test_kind: int, trial_ki
 
 
 @njit(cache=True, nogil=True)
-def _sandwich_rows(indptr, indices, data, V, out, rows):
-    """out[i, j] = out[j, i] = (R V R^T)[i, j] for i in ``rows``, j >= i (R in CSR)."""
+def _sandwich_rows(indptr, indices, data, V, out, both, rows):
+    """out[i, j] = (R V R^T)[i, j] for i in ``rows``, j >= i (R in CSR), and out[j, i] if
+    ``both``.  Threads write the upper triangle only and mirror it afterwards: a thread
+    writing out[j, i] too touched every row of out, and on a fresh matrix the first
+    chunk took all page faults, 0.3 s of a serial step at N = 4096; one thread writes
+    both (the mirror pass costs it ~15 % of W)."""
     n = out.shape[0]
     for i in rows:
         for j in range(i, n):
@@ -512,7 +580,8 @@ def _sandwich_rows(indptr, indices, data, V, out, rows):
                     s += V[k, indices[b]] * data[b]
                 acc += data[a] * s
             out[i, j] = acc
-            out[j, i] = acc
+            if both:
+                out[j, i] = acc
 
 
 @njit(cache=True)
@@ -551,6 +620,11 @@ def sandwich(T, V: np.ndarray) -> np.ndarray:
         indptr, indices, data = R.indptr, R.indices, R.data
     n = T.shape[1]
     out = np.empty((n, n))
-    _threaded(_sandwich_rows, (indptr, indices, data, np.ascontiguousarray(V), out),
-              np.arange(n) if numba.get_num_threads() <= 1 else _interleaved(n), 0.5 * n * n)
+    V = np.ascontiguousarray(V)
+    if _n_threads(0.5 * n * n) <= 1:
+        _sandwich_rows(indptr, indices, data, V, out, True, np.arange(n))
+    else:
+        _threaded(_sandwich_rows, (indptr, indices, data, V, out, False), _interleaved(n),
+                  0.5 * n * n)
+        _mirror_upper(out)
     return out
