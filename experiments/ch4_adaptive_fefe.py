@@ -185,12 +185,9 @@ def solve_pair(meshes, prm: Params):
     pr = TwoBodyContact(S, M, CONTACT_BOUNDARY["slave"], CONTACT_BOUNDARY["master"],
                         eps_n=1.0 / (prm.eps_n_factor * prm.E),
                         eps_t=1.0 / (prm.eps_t_factor * prm.E), mu_f=prm.mu_f)
-    top = pr.dofs_on("slave", "top")
-    bx, by = pr.dofs_on("master", "bottom", 0), pr.dofs_on("master", "bottom", 1)
-    fixed = np.concatenate([top, bx, by])
-    vals = np.concatenate([np.zeros(top.size + bx.size), np.full(by.size, prm.u_master)])
+    fixed, is_y = pr.stamp_dofs()
     n = prm.load_steps
-    res = pr.solve(None, fixed, vals, load_factors=np.arange(1, n + 1) / n, rtol=prm.rtol,
+    res = pr.solve(None, fixed, prm.u_master * is_y, load_factors=np.arange(1, n + 1) / n, rtol=prm.rtol,
                    max_iter=prm.max_newton, max_cuts=prm.load_retries,
                    linear_solver=prm.linear_solver)
     return pr, res

@@ -34,10 +34,8 @@ def _solve(meshes):
     S, M = (ElasticBody(m, E, NU, "strain") for m in meshes)
     pr = TwoBodyContact(S, M, ["bottom", "left", "right"], ["top", "left", "right"],
                         eps_n=1.0 / (10 * E), eps_t=1.0 / (5 * E), mu_f=0.1)
-    top = pr.dofs_on("slave", "top")
-    bx, by = pr.dofs_on("master", "bottom", 0), pr.dofs_on("master", "bottom", 1)
-    vals = np.concatenate([np.zeros(top.size + bx.size), np.full(by.size, 5e-4)])
-    res = pr.solve(None, np.concatenate([top, bx, by]), vals,
+    fixed, is_y = pr.stamp_dofs()
+    res = pr.solve(None, fixed, 5e-4 * is_y,
                    load_factors=np.arange(1, 6) / 5, rtol=1e-10, max_iter=30)
     assert res.converged, res.reason
     return pr, res

@@ -253,11 +253,8 @@ def test_rectangle_work_piece_in_two_body_contact():
     body = PlasticBEBody(be)
     pr = TwoBodyContact(stamp, body, "bottom", "top", eps_n=1 / (10 * mat.E),
                         eps_t=1 / (5 * mat.E), mu_f=0.2)
-    top = pr.dofs_on("slave", "top")
-    bx, by = pr.dofs_on("master", "bottom", 0), pr.dofs_on("master", "bottom", 1)
-    fixed = np.concatenate([top, bx, by])
-    vals = np.concatenate([np.zeros(top.size + bx.size), 4e-3 * np.ones(by.size)])
-    res = pr.solve(None, fixed, vals, load_factors=np.linspace(0.25, 1, 4), rtol=1e-8,
+    fixed, is_y = pr.stamp_dofs()
+    res = pr.solve(None, fixed, 4e-3 * is_y, load_factors=np.linspace(0.25, 1, 4), rtol=1e-8,
                    max_iter=40, line_search=True)
     assert res.converged
     assert be.plastic.any()

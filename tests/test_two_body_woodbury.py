@@ -12,7 +12,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from hpfebe.contact.loading import LoadSteps, WoodburySolver
+from hpfebe.contact.loading import WoodburySolver
 from hpfebe.contact.two_body import TwoBodyContact
 from hpfebe.fem import refine_labelled
 from hpfebe.fem.elasticity import ElasticBody, rectangle_mesh
@@ -28,10 +28,8 @@ def _problem(refine=1):
     S, M = (ElasticBody(m, E, NU, "strain") for m in ms)
     pr = TwoBodyContact(S, M, ["bottom", "left", "right"], ["top", "left", "right"],
                         eps_n=1.0 / (10 * E), eps_t=1.0 / (5 * E), mu_f=0.1)
-    top = pr.dofs_on("slave", "top")
-    bx, by = pr.dofs_on("master", "bottom", 0), pr.dofs_on("master", "bottom", 1)
-    vals = np.concatenate([np.zeros(top.size + bx.size), np.full(by.size, 5e-4)])
-    return pr, np.concatenate([top, bx, by]), vals
+    fixed, is_y = pr.stamp_dofs()
+    return pr, fixed, 5e-4 * is_y
 
 
 def _solve(linear_solver, predictor=False):

@@ -147,6 +147,18 @@ def _on_line(p0, p1, a, n0, n1):
 
 
 @njit(cache=True, inline="always")
+def _k_entries(p0, p1, a, d, J0, J1):
+    """The K entries (hat at the start a, hat at the end) of the test element [p0, p1]
+    against the trial element starting at a with unit direction d (normal n = -i d),
+    from J0, J1 of (K1); zero if the test element lies on the trial element's line."""
+    n0, n1 = d.imag, -d.real
+    if _on_line(p0, p1, a, n0, n1):
+        return 0.0, 0.0
+    n = complex(n0, n1)
+    return INV_2PI * (n * (0.5 * J0 - J1)).real, INV_2PI * (n * (0.5 * J0 + J1)).real
+
+
+@njit(cache=True, inline="always")
 def _smooth_pair(u, v, wm, r):
     """Nearly parallel (|sin| < SIN_SMOOTH) but not on one line (the midpoint of E_i off
     the line of E_j by more than 1e-10 |w_m|): neighbours on a smooth curve, whose K
@@ -359,25 +371,15 @@ def _vk_rows(zs, ze, L, dirs, nodes, elements, vdofs, wdofs, logR, V, K, R, dire
             wj = wdofs[j]
             V[wi, wj] = -INV_2PI * I
             V[wj, wi] = V[wi, wj]
-            # K of (test i, trial j): n_j = -i v; zero if E_i lies on the line of E_j
-            nj0, nj1 = v.imag, -v.real
-            if not _on_line(nodes[elements[i, 0]], nodes[elements[i, 1]],
-                            nodes[elements[j, 0]], nj0, nj1):
-                nj = complex(nj0, nj1)
-                ka = INV_2PI * (nj * (0.5 * J0 - J1)).real
-                kb = INV_2PI * (nj * (0.5 * J0 + J1)).real
-                if vdofs[j, 0] >= 0:
-                    K[wi, vdofs[j, 0]] += ka
-                if vdofs[j, 1] >= 0:
-                    K[wi, vdofs[j, 1]] += kb
-            ka = 0.0
-            kb = 0.0
-            ni0, ni1 = u.imag, -u.real
-            if not _on_line(nodes[elements[j, 0]], nodes[elements[j, 1]],
-                            nodes[elements[i, 0]], ni0, ni1):
-                ni = complex(ni0, ni1)
-                ka = INV_2PI * (ni * (0.5 * J0r - J1r)).real
-                kb = INV_2PI * (ni * (0.5 * J0r + J1r)).real
+            # K of (test i, trial j) and of (test j, trial i)
+            ka, kb = _k_entries(nodes[elements[i, 0]], nodes[elements[i, 1]],
+                                nodes[elements[j, 0]], v, J0, J1)
+            if vdofs[j, 0] >= 0:
+                K[wi, vdofs[j, 0]] += ka
+            if vdofs[j, 1] >= 0:
+                K[wi, vdofs[j, 1]] += kb
+            ka, kb = _k_entries(nodes[elements[j, 0]], nodes[elements[j, 1]],
+                                nodes[elements[i, 0]], u, J0r, J1r)
             if direct:
                 if vdofs[i, 0] >= 0:
                     K[wj, vdofs[i, 0]] += ka

@@ -181,11 +181,7 @@ def _stamp_on_work(stamp, body, E: float, settings: ContactSettings):
     pr = TwoBodyContact(stamp, body, "bottom", "top",
                         eps_n=1.0 / (settings.eps_n_factor * E),
                         eps_t=1.0 / (settings.eps_t_factor * E), **settings.friction())
-    top = pr.dofs_on("slave", "top")
-    bx, by = pr.dofs_on("master", "bottom", 0), pr.dofs_on("master", "bottom", 1)
-    fixed = np.concatenate([top, bx, by])
-    is_y = np.concatenate([np.zeros(top.size + bx.size, bool), np.ones(by.size, bool)])
-    return pr, fixed, is_y
+    return (pr, *pr.stamp_dofs())
 
 
 def touch(stamp, fe: ElastoPlasticFE, u_total: float, n_load: int, n_unload: int,

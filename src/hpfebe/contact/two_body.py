@@ -435,6 +435,16 @@ class TwoBodyContact:
     def dofs_on(self, body: str, labels, component: Optional[int] = None) -> np.ndarray:
         return self.global_dofs(body, self._contact_body(body).dofs_on(labels, component))
 
+    def stamp_dofs(self) -> tuple[np.ndarray, np.ndarray]:
+        """The dofs a stamp scene prescribes (Sections 4.2.7, 4.2.8, 4.4: the slave
+        stamp held at its "top", the master work piece moved at its "bottom" in y and held
+        in x): (fixed, is_y), with ``is_y`` marking the master's bottom y components (the
+        prescribed values are lift * is_y)."""
+        top = self.dofs_on("slave", "top")
+        bx, by = self.dofs_on("master", "bottom", 0), self.dofs_on("master", "bottom", 1)
+        is_y = np.concatenate([np.zeros(top.size + bx.size, bool), np.ones(by.size, bool)])
+        return np.concatenate([top, bx, by]), is_y
+
     def dofs_at(self, body: str, point, component: Optional[int] = None) -> np.ndarray:
         return self.global_dofs(body, self._contact_body(body).dofs_at(point, component))
 
