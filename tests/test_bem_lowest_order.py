@@ -194,3 +194,31 @@ def test_smooth_curve():
     assert _rel(fast.V, ref.V) <= 1e-13
     assert _rel(fast.K, ref.K) <= 1e-13
     assert _rel(fast.W, ref.W) <= 3e-13
+
+
+@pytest.mark.parametrize("short", [1e-6, 1e-9, 1e-12])
+def test_tiny_element_beside_long_collinear_ones(short):
+    """A side split into one element of length ``short`` and three of length 1/3: the V
+    entries of the short element against its collinear neighbours to 1e-14 of each entry
+    (reference: the one-dimensional closed form in mpmath, on the mesh's own floating
+    point nodes), and W = T^T V T (which scales these rows by 1/short^2) to 1e-13 of its
+    largest entry against the quadrature path.  Forming log(w+/w-) from the rounded
+    corner differences lost 4e-8 of these entries at short = 1e-9."""
+    mp = pytest.importorskip("mpmath")
+    mp.mp.dps = 40
+    m = BoundaryMesh.polygon([(0, 0), (1, 0), (1, short), (1, 1), (0, 1)],
+                             n=[4, 1, 3, 4, 4], p=1)
+    op, ref = LaplaceBEM(m), LaplaceBEM(m, closed_form=False)
+    e = int(np.argmin(m.lengths))
+    y = [tuple(mp.mpf(float(m.nodes[k, 1])) for k in m.elements[f]) for f in range(e, e + 4)]
+    logR = mp.log(mp.mpf(op.scale))
+
+    def phi(x):
+        return mp.mpf(0) if x == 0 else x ** 2 / 2 * (mp.log(abs(x)) - mp.mpf(3) / 2)
+
+    for k, (b0, b1) in enumerate(y):
+        a0, a1 = y[0]
+        integral = -(phi(a1 - b1) - phi(a1 - b0) - phi(a0 - b1) + phi(a0 - b0))
+        exact = -(integral - (a1 - a0) * (b1 - b0) * logR) / (2 * mp.pi)
+        assert abs(op.V[e, e + k] - exact) <= 1e-14 * abs(exact), (k, op.V[e, e + k], exact)
+    assert np.abs(op.W - ref.W).max() <= 1e-13 * np.abs(ref.W).max()

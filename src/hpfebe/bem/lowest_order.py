@@ -176,12 +176,16 @@ def _log_ratio(w, wm, r2m):
 
 
 @njit(cache=True, inline="always")
-def _log_quotient(wp, wn):
+def _log_quotient(wp, wn, d):
     """log(wp / wn), principal branch, to full relative accuracy also for wp close to wn
-    (by log1p of z = (wp - wn) / wn when |z| < 1/2; directly otherwise, where log1p's
-    argument 2 Re z + |z|^2 would cancel, e.g. for wp close to 0)."""
+    (by log1p of z = d / wn when |z| < 1/2; directly otherwise, where log1p's argument
+    2 Re z + |z|^2 would cancel, e.g. for wp close to 0).  ``d`` = wp - wn formed from
+    the element's own end points (b_i - a_i, exact for nearby nodes): the difference of
+    the rounded wp, wn would carry an error of eps |wp| into a d of the size of a short
+    element (measured: V entries of a 1e-9 element against collinear neighbours 4e-8
+    off relative, against 2e-16 with d)."""
     r2n = wn.real * wn.real + wn.imag * wn.imag
-    z = (wp - wn) * wn.conjugate() / r2n
+    z = d * wn.conjugate() / r2n
     z2 = z.real * z.real + z.imag * z.imag
     if z2 < 0.25:
         return complex(0.5 * math.log1p(2.0 * z.real + z2), math.atan2(z.imag, 1.0 + z.real))
@@ -216,7 +220,7 @@ def _pair_sums(ai, bi, aj, bj, A, v, Lj, wm):
         z = 0.5 * (wp + wn)
         if wp != 0j and wn != 0j:
             lsum = _log_ratio(wp, wm, r2m) + _log_ratio(wn, wm, r2m)
-            ldif = _log_quotient(wp, wn)
+            ldif = _log_quotient(wp, wn, 2.0 * A)
             sv += st * (2.0 * z * A * lsum + (z * z + A * A) * ldif)
             s0 += st * (A * lsum + z * ldif)
             s1 += st * (A * (z + tv) * lsum + (0.5 * (z * z + A * A) + z * tv) * ldif)
