@@ -970,7 +970,7 @@ def model_problem(n1: int = 16, n2: int = 12, p1: int = 2, p2: int = 2,
                   u_top=(0.0, -0.09), radius: float = 5.05, plane: str = "strain",
                   L: float = 2.0, side_depth: float = 2.0,
                   test_space: str = "full", geometry: str = "arc",
-                  bem_cache: dict | None = None) -> MortarContact:
+                  bem_cache: dict | None = None, gap=None) -> MortarContact:
     """The model problem of Section 4.3.4 (thesis lines 19474-19530): body 1 bounded by
     Gamma^1_D = [-1,1] x {2} (U = u_top), Gamma^1_N = {-1,1} x [0.1, 2] and the arc
     Gamma^1_C of radius ``radius`` through (-1, 0.1), (0, 0), (1, 0.1); body 2 =
@@ -983,11 +983,13 @@ def model_problem(n1: int = 16, n2: int = 12, p1: int = 2, p2: int = 2,
     ``test_space``: of the mortar projection (:class:`MortarContact`).  ``bem_cache``: a
     dict keeping the BE bodies (and their assembled operators) across calls - body 1
     depends only on (n1, p1, radius, L, geometry), body 2 on (n2, p2, L, side_depth), so
-    a sweep over degree pairs assembles each body once."""
+    a sweep over degree pairs assembles each body once.  ``gap``: an initial gap function
+    replacing the scene's (e.g. zero: Algorithm 4.5's step 3 as printed, without g)."""
     if not np.isfinite(F) or F < 0:
         raise ValueError(f"F must be >= 0, got {F!r}")
     mesh1, mesh2, normal = model_meshes(n1, n2, p1, p2, radius, L, side_depth, geometry)
-    gap = model_gap(radius) if geometry == "flat" else None
+    if gap is None and geometry == "flat":
+        gap = model_gap(radius)
     if bem_cache is None:
         return contact_from_meshes(mesh1, mesh2, normal, E, nu, F, u_top, plane,
                                    test_space, gap)
