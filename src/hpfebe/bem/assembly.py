@@ -63,8 +63,14 @@ def _collinear(nodes, elements, normals, i, j):
     nJ = normals[j]
     d0 = (aI[0] - aJ[0]) * nJ[0] + (aI[1] - aJ[1]) * nJ[1]
     d1 = (bI[0] - aJ[0]) * nJ[0] + (bI[1] - aJ[1]) * nJ[1]
-    return (abs(d0) <= 1e-15 * math.hypot(aI[0] - aJ[0], aI[1] - aJ[1])
-            and abs(d1) <= 1e-15 * math.hypot(bI[0] - aJ[0], bI[1] - aJ[1]))
+    # |d| > 1e-15 (|x| + |y|) >= 1e-15 hypot(x, y): not collinear, without the libm
+    # hypot call (its cost dominated K's far pairs, issue 14)
+    x0, y0 = aI[0] - aJ[0], aI[1] - aJ[1]
+    if abs(d0) > 1e-15 * (abs(x0) + abs(y0)) or abs(d0) > 1e-15 * math.hypot(x0, y0):
+        return False
+    x1, y1 = bI[0] - aJ[0], bI[1] - aJ[1]
+    return not (abs(d1) > 1e-15 * (abs(x1) + abs(y1))
+                or abs(d1) > 1e-15 * math.hypot(x1, y1))
 
 
 @njit(cache=True)
@@ -133,8 +139,9 @@ def _rows(kernel, logc, haslog, kp, d, nodes, elements, normals, L, mid,
                 # tabulated.  Written out here, not a call of integration.far_block: a
                 # call with ~30 array arguments per pair cost more than its quadrature
                 # (measured: K for N = 1024, p = 1 went from 0.63 s to 0.19 s)
-                dlow = (math.hypot(mid[i, 0] - mid[j, 0], mid[i, 1] - mid[j, 1])
-                        - 0.5 * (L[i] + L[j]))
+                dm0 = mid[i, 0] - mid[j, 0]
+                dm1 = mid[i, 1] - mid[j, 1]
+                dlow = math.sqrt(dm0 * dm0 + dm1 * dm1) - 0.5 * (L[i] + L[j])
                 nx = ntab
                 ny = ntab
                 if dlow >= 2.0 * ETA * max(L[i], L[j]):
