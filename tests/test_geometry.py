@@ -83,6 +83,16 @@ def test_zero_length_element():
         BoundaryMesh.from_segments(nodes, [[0, 1], [1, 2], [2, 3], [3, 4], [4, 0]])
 
 
+@pytest.mark.parametrize("scale", [1e160, 1e-170])
+def test_coordinates_whose_squares_overflow_or_underflow(scale):
+    # a 1e-170 square used to fail as "zero-length element" (squared lengths underflow),
+    # a 1e160 one with "cannot convert float NaN to integer"
+    nodes = np.array(SQUARE, dtype=float) * scale
+    with pytest.raises(ValueError, match=r"nodes: .*rescale the geometry"):
+        BoundaryMesh.from_segments(nodes, [[0, 1], [1, 2], [2, 3], [3, 0]])
+    assert BoundaryMesh.from_segments(nodes / scale * 1e99, [[0, 1], [1, 2], [2, 3], [3, 0]])
+
+
 def test_self_intersection_of_nonadjacent_collinear_overlap():
     # a spike folding back over itself: collinear overlapping segments
     nodes = np.array([(0, 0), (2, 0), (1, 0), (1, 1)], dtype=float)

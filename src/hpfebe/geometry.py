@@ -211,6 +211,9 @@ def _as_per_side(value, nsides: int, name: str):
     return value
 
 
+COORD_MIN, COORD_MAX = 1e-100, 1e100   # extent and size of a mesh's coordinates
+
+
 @dataclass(frozen=True, eq=False)
 class BoundaryMesh:
     """Straight elements on closed polygonal curves.
@@ -265,6 +268,13 @@ class BoundaryMesh:
             raise ValueError(f"nodes must have shape (n, 2), got {nodes.shape}")
         if not np.all(np.isfinite(nodes)):
             raise ValueError("nodes contain NaN or infinite coordinates")
+        size, extent = float(np.abs(nodes).max()), float(np.ptp(nodes, axis=0).max())
+        if size > COORD_MAX or extent < COORD_MIN:
+            # lengths, kernels and quadrature square distances: beyond these they
+            # overflow or underflow (a 1e-170 square had "zero-length" elements)
+            raise ValueError(f"nodes: coordinates up to {size:.3g} with extent {extent:.3g} "
+                             f"are outside [{COORD_MIN:g}, {COORD_MAX:g}], where squared "
+                             "distances overflow or underflow; rescale the geometry")
         if elements.ndim != 2 or elements.shape[1] != 2 or len(elements) < 3:
             raise ValueError(f"elements must have shape (ne, 2) with ne >= 3, "
                              f"got {elements.shape}")
