@@ -13,6 +13,7 @@ import numpy as np
 import pytest
 
 from hpfebe import BoundaryMesh
+from hpfebe.bem import LameBEM, LaplaceBEM
 
 ROOT = Path(__file__).resolve().parents[1]
 SQUARE = [(0, 0), (1, 0), (1, 1), (0, 1)]
@@ -147,6 +148,21 @@ def test_nitsche_names_the_bad_argument(kw, match):
 def hpfebe(*args, timeout=300):
     return subprocess.run([sys.executable, "-m", "hpfebe", *args], cwd=ROOT,
                           capture_output=True, text=True, timeout=timeout)
+
+
+@pytest.mark.parametrize("make, match", [
+    (lambda m: LameBEM(m, 1.0, "0.3"), "nu .*must be a number"),
+    (lambda m: LameBEM(m, "1", 0.3), "E .*must be a number"),
+    (lambda m: LameBEM(m, True, 0.3), "E .*must be a number"),
+    (lambda m: LaplaceBEM(m, scale="2"), "scale"),
+    (lambda m: LaplaceBEM(m, zero_flux="no"), "zero_flux"),    # "no" is truthy
+    (lambda m: LameBEM(m, 1.0, 0.3, zero_force="False"), "zero_force"),
+    (lambda m: LaplaceBEM(m).Psi(np.ones(3)), "U must have 8 rows"),
+    (lambda m: LaplaceBEM(m).Psi(np.full(8, np.nan)), "U contains NaN"),
+])
+def test_boundary_operators_name_the_bad_argument(make, match):
+    with pytest.raises(ValueError, match=match):
+        make(BoundaryMesh.polygon(SQUARE, n=2, p=1))
 
 
 @pytest.mark.parametrize("text, match", [

@@ -19,6 +19,9 @@ PLANES = ("strain", "stress")
 
 def lame_constants(E: float, nu: float, plane: str = "strain") -> tuple[float, float]:
     """(lambda, mu) of the 2D model: plane strain, or plane stress with lambda*."""
+    for name, v in (("E (Young's modulus)", E), ("nu (Poisson ratio)", nu)):
+        if isinstance(v, (str, bytes, bool, np.bool_)):    # "0.3" is no silent 0.3
+            raise ValueError(f"{name} must be a number, got {v!r}")
     E = float(E)
     nu = float(nu)
     if not (math.isfinite(E) and E > 0):

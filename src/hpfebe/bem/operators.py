@@ -59,9 +59,14 @@ class BoundaryOperators:
         if not isinstance(mesh, BoundaryMesh):
             raise ValueError(f"mesh must be a BoundaryMesh, got {type(mesh).__name__}")
         self.mesh = mesh
+        if isinstance(scale, (str, bytes, bool, np.bool_)):
+            raise ValueError(f"scale must be a positive number, got {scale!r}")
         self.scale = float(scale)
         if not (math.isfinite(self.scale) and self.scale > 0):
             raise ValueError(f"scale must be positive, got {scale!r}")
+        if not isinstance(constrained, (bool, np.bool_)):   # "no" would be True
+            raise ValueError("zero_flux / zero_force must be a bool, got "
+                             f"{constrained!r}")
         self.constrained = bool(constrained)
         self.W_space = DiscontinuousSpace(mesh)
         self.V_space = ContinuousSpace(mesh)
@@ -109,8 +114,15 @@ class BoundaryOperators:
         return self._get("S_hat", build)
 
     def Psi(self, U) -> np.ndarray:
-        """Discrete traction Psi = P (K + M/2) U in W_hp."""
-        psi = sla.cho_solve(self.V_cho, self.B @ np.asarray(U))
+        """Discrete traction Psi = P (K + M/2) U in W_hp (``U``: coefficients in V_hp,
+        one vector or the columns of a matrix)."""
+        U = np.asarray(U, dtype=float)
+        n = self.d * self.V_space.ndof
+        if U.ndim not in (1, 2) or U.shape[0] != n:
+            raise ValueError(f"U must have {n} rows (d x V_hp dofs), got shape {U.shape}")
+        if not np.all(np.isfinite(U)):
+            raise ValueError("U contains NaN or infinite entries")
+        psi = sla.cho_solve(self.V_cho, self.B @ U)
         if self.constrained:
             C = self.constraints
             VC = self._get("V_inv_C", lambda: sla.cho_solve(self.V_cho, C))
