@@ -592,6 +592,16 @@ def test_line_search_keeps_full_steps_when_they_decrease_the_residual():
         pr.solve(None, fixed, values, min_step=0.0)
 
 
+def test_fixed_values_named_when_wrong():
+    pr, fixed, values = punch()
+    with pytest.raises(ValueError, match=r"fixed_values must be a scalar or have shape"):
+        pr.solve(None, fixed, values[:3])          # was numpy's broadcasting error
+    with pytest.raises(ValueError, match="fixed_values must be finite"):
+        pr.solve(None, fixed, np.where(values != 0, np.nan, 0.0))
+    with pytest.raises(ValueError, match="fixed_values must be finite"):
+        pr.solve(None, fixed, lambda lam: np.full(fixed.size, np.inf))
+
+
 @pytest.mark.parametrize("combo", [("BE", "FE"), ("FE", "BE"), ("BE", "BE")])
 def test_figure_4_13_coarse_with_boundary_elements(combo):
     """The h = 1/2 scene with BE bodies (p = 1, elements of length 1/2; FE bodies P1

@@ -107,14 +107,15 @@ class LoadSteps:
             raise ValueError("f_ext must be finite")
         v = self.fixed_values
         if v is None:
-            g = np.zeros(fixed.size)
-        elif callable(v):
-            g = np.asarray(v(lam), dtype=float) * np.ones(fixed.size)
-        else:
-            g = lam * np.asarray(v, dtype=float) * np.ones(fixed.size)
-        if g.shape != (fixed.size,):
-            raise ValueError(f"fixed_values must have shape ({fixed.size},), got {g.shape}")
-        return f, g
+            return f, np.zeros(fixed.size)
+        g = np.asarray(v(lam) if callable(v) else v, dtype=float)
+        if g.shape not in ((), (fixed.size,)):     # a scalar, or one value per fixed dof
+            raise ValueError(f"fixed_values must be a scalar or have shape ({fixed.size},) "
+                             f"(one per fixed dof), got {g.shape}")
+        if not np.all(np.isfinite(g)):
+            raise ValueError("fixed_values must be finite")
+        g = np.broadcast_to(g, (fixed.size,)).astype(float)
+        return f, (g if callable(v) else lam * g)
 
     # LoadStep protocol
     def problem(self, lam: float):
