@@ -593,11 +593,11 @@ def test_line_search_keeps_full_steps_when_they_decrease_the_residual():
 
 
 def test_fixed_values_named_when_wrong():
-    pr, fixed, values = punch()
+    pr, fixed, _ = punch()
     with pytest.raises(ValueError, match=r"fixed_values must be a scalar or have shape"):
-        pr.solve(None, fixed, values[:3])          # was numpy's broadcasting error
+        pr.solve(None, fixed, np.zeros(3))          # was numpy's broadcasting error
     with pytest.raises(ValueError, match="fixed_values must be finite"):
-        pr.solve(None, fixed, np.where(values != 0, np.nan, 0.0))
+        pr.solve(None, fixed, np.full(fixed.size, np.nan))
     with pytest.raises(ValueError, match="fixed_values must be finite"):
         pr.solve(None, fixed, lambda lam: np.full(fixed.size, np.inf))
 
