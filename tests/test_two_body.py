@@ -606,9 +606,13 @@ def test_fixed_values_named_when_wrong():
 def test_figure_4_13_coarse_with_boundary_elements(combo):
     """The h = 1/2 scene with BE bodies (p = 1, elements of length 1/2; FE bodies P1
     triangles).  Measured: plain Newton hits max_iter for BE/FE (load step 5) and FE/BE
-    (step 2); with the line search all three converge in <= 4 iterations per step
+    (step 2); with the line search all three converge in a few iterations per step
     (e.g. FE/BE step 1: 2.8e1, 7.7e-1, 4.9e-1, 3.1e-1, 2.0e-14), one slave point sticks
-    at the centre (BE/BE: none), the bottom corners slip, the slave's sides stay open."""
+    at the centre (BE/BE: none), the bottom corners slip, the slave's sides stay open.
+    How many moves with round-off: points at the Coulomb bound flip between stick and
+    slip.  BE/FE with the quadrature operators plus a random 1e-15 relative perturbation
+    of V, K, W (8 seeds): at most 2, 3, 4, 6, 3, 2, 2, 2 per step; the closed-form p = 1
+    operators: 6 (one OpenBLAS thread) or 3 (two)."""
     h = 0.5
     s = (be_rect(-0.5, 0.5, 0, 2, [2, 4, 2, 4], 1) if combo[0] == "BE"
          else fe_rect(-0.5, 0.5, 0, 2, 2, 4, "tri"))
@@ -626,7 +630,7 @@ def test_figure_4_13_coarse_with_boundary_elements(combo):
     # numpy 2.4 / OpenBLAS here, on the old and the new code alike): not asserted
     res = pr.solve(None, fixed, vals, load_factors=lf, max_iter=30, line_search=True)
     assert res.converged, res.reason
-    assert max(res.iterations) <= 4
+    assert max(res.iterations) <= 6
     assert all(np.all(np.diff(st.residuals) < 0) for st in res.steps)
     assert all(st.residuals[-1] <= 1e-10 * st.residuals[0] for st in res.steps)
     side = np.abs(np.abs(res.points[:, 0]) - 0.5) < 1e-12

@@ -43,6 +43,12 @@ Galerkin: W = T^T Vt T with T the exact derivative matrix of :mod:`hpfebe.spaces
 component) and Vt assembled on W_hp by the same :func:`assemble` as V.  The constant R is
 irrelevant here (tangential derivatives have zero mean on closed curves).
 
+On meshes with all degrees 1, V, Vt and K have closed forms (:mod:`hpfebe.bem.lowest_order`,
+formulas (Q1), (Q2), (L1), (L2): K by the Guenter-derivative representation
+K = K_Laplace I + (V_Laplace I - 2 mu V)(I J) T, J = [[0, 1], [-1, 0]]), used unless
+``closed_form=False``; the general quadrature path of :func:`assemble` is the reference
+(they agree to 1e-13 of the largest entry, tests/test_bem_lowest_order_lame.py).
+
 Vector functions are interleaved: global index = 2 * scalar dof + component.
 
 S_hat (Section 1.4) with a zero total force constraint (the analogue of the zero-flux
@@ -70,6 +76,9 @@ from ..spaces import ContinuousSpace, DiscontinuousSpace
 from .assembly import assemble, local_block, sandwich
 from .kernels import (KP_C1, KP_C1_C2, KP_C1_LOG_R, KP_C2, KP_ET, KP_ET_LOG_R, KP_LAMBDA,
                       KP_LAME_SIZE, KP_MU, LAME_DL, LAME_HS, LAME_SL)
+from .laplace import P1_W_DIRECT_MAX
+from .lowest_order import applies as _closed_form_applies
+from .lowest_order import lame_p1, lame_p1_w
 from .operators import BoundaryOperators, mesh_diameter
 from .potentials import (POT_LAME_DL, POT_LAME_DL_GRAD, POT_LAME_SL, POT_LAME_SL_GRAD,
                          evaluate_potential)
@@ -137,6 +146,10 @@ class LameBEM(BoundaryOperators):
     plane : "strain" or "stress"
     scale : length scale R of the fundamental solution (default: 2 x diameter)
     zero_force : constrain Psi to zero total force (scale-invariant S_hat, module doc)
+    closed_form : on a mesh with all degrees 1, V, K and Vt by the closed forms of
+        :mod:`hpfebe.bem.lowest_order` (one pass; W = T^T Vt T without forming T up to
+        P1_W_DIRECT_MAX elements): equal to the quadrature path to round-off; ``False``
+        forces the general quadrature path
 
     Matrices (interleaved components, assembled on first use, cached): ``V`` (W_hp^2 x
     W_hp^2), ``K`` (test W_hp^2, trial V_hp^2), ``K_adj``, ``W`` (V_hp^2 x V_hp^2), ``M``,
@@ -147,7 +160,8 @@ class LameBEM(BoundaryOperators):
     d = 2
 
     def __init__(self, mesh: BoundaryMesh, E: float, nu: float, plane: str = "strain",
-                 scale: float | None = None, zero_force: bool = True):
+                 scale: float | None = None, zero_force: bool = True,
+                 closed_form: bool = True):
         self.E, self.nu, self.plane = float(E), float(nu), plane
         self.lam, self.mu = lame_constants(E, nu, plane)
         if isinstance(mesh, BoundaryMesh) and scale is None:
@@ -155,6 +169,18 @@ class LameBEM(BoundaryOperators):
         super().__init__(mesh, scale, constrained=zero_force)
         self.zero_force = self.constrained
         self.kp = _checked_kernel_params(E, nu, self.lam, self.mu, self.scale)
+        if not isinstance(closed_form, (bool, np.bool_)):
+            raise ValueError(  # noqa: TRY004 - the project's ValueError for bad input
+                f"closed_form must be a bool, got {closed_form!r}")
+        # p = 1 everywhere: V, K and Vt by the closed forms, all in one pass
+        self.closed_form = bool(closed_form) and _closed_form_applies(mesh)
+
+    def _closed(self, key: str) -> None:
+        """One pass of the closed forms fills the cache's V, K and Vt (those not there)."""
+        if self.closed_form and key not in self._cache:
+            V, K, Vt = lame_p1(self.W_space, self.V_space, self.kp, self.scale)
+            for k, A in (("V", V), ("K", K), ("Vt", Vt)):
+                self._cache.setdefault(k, A)
 
     @property
     def c1(self) -> float:
@@ -169,6 +195,7 @@ class LameBEM(BoundaryOperators):
     @property
     def V(self) -> np.ndarray:
         """Single layer (1.4), W_hp^2 x W_hp^2, symmetric positive definite."""
+        self._closed("V")
         return self._get("V", lambda: assemble(LAME_SL, _logc(self.c1), self.kp,
                                                self.W_space, self.W_space, d=2,
                                                symmetric=True))
@@ -176,6 +203,7 @@ class LameBEM(BoundaryOperators):
     @property
     def K(self) -> np.ndarray:
         """Double layer (1.4), test W_hp^2, trial V_hp^2."""
+        self._closed("K")
         return self._get("K", lambda: assemble(LAME_DL, NO_LOG, self.kp,
                                                self.W_space, self.V_space, d=2))
 
@@ -192,6 +220,7 @@ class LameBEM(BoundaryOperators):
     @property
     def Vt(self) -> np.ndarray:
         """Single-layer-type matrix of the hypersingular kernel Vt on W_hp^2."""
+        self._closed("Vt")
         return self._get("Vt", lambda: assemble(LAME_HS, _logc(self.Et), self.kp,
                                                 self.W_space, self.W_space, d=2,
                                                 symmetric=True))
@@ -199,6 +228,9 @@ class LameBEM(BoundaryOperators):
     @property
     def W(self) -> np.ndarray:
         """Hypersingular operator, V_hp^2 x V_hp^2: <W U, U'> = <Vt dU/ds, dU'/ds>."""
+        if self.closed_form and self.mesh.n_elements <= P1_W_DIRECT_MAX:
+            # p = 1, small mesh: T^T Vt T without forming T (as LaplaceBEM.W)
+            return self._get("W", lambda: lame_p1_w(self.Vt, self.W_space, self.V_space))
         return self._get("W", lambda: sandwich(self.T, self.Vt))
 
     @property

@@ -78,6 +78,69 @@ these entries).  Against mpmath on the 4096-gon the K entries at node offsets 3 
 then within 1e-14 of the largest entry, where the general path's Gauss fast path is off
 by 2.5e-13 .. 4.3e-13: the 1e-12 difference of the two paths there is the general one's.
 
+Lame operators (:mod:`hpfebe.bem.lame`: G = c1 {-log(r/R) I + c2 r r^T/r^2}, the
+hypersingular kernel Vt = Et {-log(r/R) I + r r^T/r^2}).  Besides I they need one complex
+integral per pair,
+
+    Q = int int w / conj(w) ds_y ds_x,   since  r r^T / r^2 = 1/2 I + 1/2 [[Re q, Im q],
+                                                                 [Im q, -Re q]],  q = w / conj w.
+
+Corner sum: with wb = conj(w), F(w, wb) = w g(wb) + h(wb) has d^2 F / ds dt = w / wb for
+g(z) = -(z log z - z) / (ub vb), h(z) = c (z^2 log z / 2 - 3 z^2 / 4), c = (u vb + ub v) /
+(ub vb)^2 (ub = conj u; check: d^2F/dsdt = -g'(wb) (u vb + ub v) - ub vb (w g'' + h'')
+with g'' = -1 / (ub vb wb) and h'' = c log wb).  Summing F over the corners as in (V1),
+with log wb_c = log wb_m + conj(l_c), l_c = log(w_c / w_m): the constant log wb_m
+multiplies -(ub vb)^(-1) sum s_c |w_c|^2 + c/2 sum s_c wb_c^2 = 2 Re(u vb) L_i L_j / (ub
+vb) - 2 Re(u vb) L_i L_j / (ub vb) = 0 (sum s_c |w_c|^2 = -2 Re(u vb) L_i L_j, sum s_c
+wb_c^2 = -2 ub vb L_i L_j), so the same branch as (V1) serves, and
+
+    conj Q = -(u v)^(-1) sum_c s_c |w_c|^2 l_c + Re(u vb) (u v)^(-2) sum_c s_c w_c^2 l_c
+             + Re(u vb) L_i L_j / (u v)                                                 (Q1)
+
+(sum s_c w_c^2 l_c is the sum of (V1); that of |w|^2 is paired along the shorter element
+like it, :func:`_pair_sums`).  A corner w_c = 0 contributes 0; collinear pairs (the
+identical one included) have Q = u^2 L_i L_j exactly and are set so.  Far pairs:
+w / wb = (w_m / wb_m) (1 + z) / (1 + conj z), z = a alpha + b beta (a, b as above), and
+E[(1 + z) sum_k (-conj z)^k] has only the moments E[conj z^k] (k even: the c0 sums) and
+E[alpha conj z^k], E[beta conj z^k] (k odd: the c1 sums with the roles of a, b as in J1
+and J1'), so with the sums s0 = sum c0_mj a^m b^j, s1 = sum c1_mj a^m b^j (m even, j
+odd), s1' = sum c1_jm a^m b^j (m odd, j even) that give J0, J1, J1',
+
+    Q = L_i L_j (w_m / wb_m) [conj(s0) + a conj(s1') + b conj(s1)],                    (Q2)
+
+whose tail is (1 + q) times that of the double layer's series (the same order n).
+Measured (tests/test_bem_lowest_order_lame.py): (Q1) against (Q2) within 5.8e-15, 1.1e-14,
+2.4e-14 of L_i L_j at q = 0.225, 0.125, 0.05; (Q1) against a 200-point Gauss rule for
+adjacent pairs at 30 ... 150 degrees.
+
+Lame matrices (:func:`lame_p1`, interleaved components, 2 x 2 block per pair, I' = I - L_i
+L_j log R = -2 pi V_Laplace):
+
+    V_ij  = c1 [-I' I + c2 R_ij],  Vt_ij = Et [-I' I + R_ij],
+    R_ij  = L_i L_j / 2 I + 1/2 [[Re Q, Im Q], [Im Q, -Re Q]],                         (L1)
+
+and the double layer by its Guenter-derivative representation (Kupradze; Steinbach,
+"Numerical Approximation Methods for Elliptic Boundary Value Problems", Springer 2008,
+chapter on linear elastostatics, in 3D with the Guenter derivative M; in 2D M u = J du/ds
+with J = [[0, 1], [-1, 0]] for our orientation):
+
+    K = K_Laplace I + (V_Laplace I - 2 mu V) (I J) T                                   (L2)
+      = K_Laplace I - alpha (V_Laplace J) T - beta Q_b (I J) T,
+    alpha = mu / (lambda + 2 mu),  beta = (lambda + mu) / (4 pi (lambda + 2 mu)),
+    Q_b = [[Re Q, Im Q], [Im Q, -Re Q]] per pair
+
+(T the P1 derivative matrix per component; the L_i L_j and log R parts of V drop out
+against T, whose columns integrate to zero on closed curves: m^T T = 0).  How (L2) was
+established: a least-squares fit of K_quadrature - K_Laplace I over the candidates
+(V_Laplace J) T, R (I J) T and (I J) R T on an L-shape for three materials gave the
+coefficients -alpha, -beta, +beta (residual 8e-16 of max |K|), and R (I J) - (I J) R =
+Q_b (I J); the second line follows from the first with V = 2 pi c1 V_Laplace + c1 c2 R
+(1 - 4 pi mu c1 = -alpha, 2 mu c1 c2 = 2 beta).  The test checks (L2) on the quadrature
+matrices alone at p = 2 (to 1e-13), where no closed form is involved.  :func:`lame_p1` runs the pass of :func:`laplace_p1_vk` with Q and then
+one row pass (:func:`_lame_rows`) that writes V, Vt and K; :func:`lame_p1_w` forms W = T^T
+Vt T per component pair by :func:`laplace_p1_w` (the blocks Vt[k::2, l::2] are symmetric).
+Nothing of the general quadrature path is compiled for p = 1.
+
 :func:`laplace_p1_vk` assembles V and K of a mesh with all degrees 1 in one pass over the
 unordered element pairs, on several threads for large meshes with the same bits
 (:class:`~hpfebe.bem.laplace.LaplaceBEM` uses it there; the general quadrature path of
@@ -95,6 +158,8 @@ from math import comb
 import numba
 import numpy as np
 from numba import njit
+
+from .kernels import KP_C1, KP_C1_C2, KP_ET, KP_LAMBDA, KP_LAME_SIZE, KP_MU
 
 INV_2PI = 1.0 / (2.0 * math.pi)
 
@@ -196,8 +261,8 @@ def _log_quotient(wp, wn, d):
 
 @njit(cache=True)
 def _pair_sums(ai, bi, aj, bj, A, v, Lj, wm):
-    """The corner sums of (V1), (K1): sum_c s_c P(w_c) log(w_c / w_m) for P = w^2, w,
-    w (w/2 + t v), w (w/2 - s u), each as a sum over the two ends y of E_j of the
+    """The corner sums of (V1), (K1), (Q1): sum_c s_c P(w_c) log(w_c / w_m) for P = w^2,
+    w, w (w/2 + t v), w (w/2 - s u), |w|^2, each as a sum over the two ends y of E_j of the
     difference of the corners x = b_i, a_i (w = z +- A, z = m_i - y, A = (b_i - a_i)/2):
 
         P+ l+ - P- l- = (P+ - P-)/2 (l+ + l-) + (P+ + P-)/2 log(w+ / w-),
@@ -211,6 +276,7 @@ def _pair_sums(ai, bi, aj, bj, A, v, Lj, wm):
     s0 = 0j
     s1 = 0j
     s1r = 0j
+    sq = 0j
     for e in range(2):
         y = bj if e == 0 else aj
         st = 1.0 if e == 0 else -1.0
@@ -225,32 +291,40 @@ def _pair_sums(ai, bi, aj, bj, A, v, Lj, wm):
             s0 += st * (A * lsum + z * ldif)
             s1 += st * (A * (z + tv) * lsum + (0.5 * (z * z + A * A) + z * tv) * ldif)
             s1r += st * (0.5 * (z * z - A * A) * ldif)
+            # |w+|^2 - |w-|^2 = 4 Re(z conj(A)), |w+|^2 + |w-|^2 = 2 (|z|^2 + |A|^2)
+            zA = z * A.conjugate()
+            sq += st * (2.0 * zA.real * lsum
+                        + (z.real * z.real + z.imag * z.imag + A.real * A.real
+                           + A.imag * A.imag) * ldif)
         elif wp != 0j:
             lg = _log_ratio(wp, wm, r2m) * st
             sv += wp * wp * lg
             s0 += wp * lg
             s1 += wp * (0.5 * wp + tv) * lg
             s1r += wp * (0.5 * wp - A) * lg
+            sq += (wp.real * wp.real + wp.imag * wp.imag) * lg
         elif wn != 0j:
             lg = _log_ratio(wn, wm, r2m) * (-st)
             sv += wn * wn * lg
             s0 += wn * lg
             s1 += wn * (0.5 * wn + tv) * lg
             s1r += wn * (0.5 * wn + A) * lg
-    return sv, s0, s1, s1r
+            sq += (wn.real * wn.real + wn.imag * wn.imag) * lg
+    return sv, s0, s1, s1r, sq
 
 
 @njit(cache=True)
 def _pair_near(ai, bi, aj, bj, Li, Lj, u, v, wm, logR):
-    """(I - L_i L_j log R, J0, J1 / L_j, J0', J1' / L_i) of formulas (V1), (K1) for a pair
-    of distinct elements; J0', J1' those of the swapped pair (test j, trial i).  The
-    corner sums are paired along the shorter element (:func:`_pair_sums`)."""
+    """(I - L_i L_j log R, J0, J1 / L_j, J0', J1' / L_i, Q) of formulas (V1), (K1), (Q1)
+    for a pair of distinct elements; J0', J1' those of the swapped pair (test j, trial
+    i), Q = Q_ij = Q_ji.  The corner sums are paired along the shorter element
+    (:func:`_pair_sums`; its sums of w^2 and |w|^2 are those of the swapped pair)."""
     if Li <= Lj:
-        sv, s0, s1, s1r = _pair_sums(ai, bi, aj, bj, 0.5 * (bi - ai), v, Lj, wm)
+        sv, s0, s1, s1r, sq = _pair_sums(ai, bi, aj, bj, 0.5 * (bi - ai), v, Lj, wm)
     else:
         # the swapped pair: corners -w_c, the same logarithms; its sums of w, w (w/2 +
         # s u), w (w/2 - t v) are -s0, s1r and s1 of this pair
-        sv, s0, s1r, s1 = _pair_sums(aj, bj, ai, bi, 0.5 * (bj - aj), u, Li, -wm)
+        sv, s0, s1r, s1, sq = _pair_sums(aj, bj, ai, bi, 0.5 * (bj - aj), u, Li, -wm)
         s0 = -s0
     r2m = wm.real * wm.real + wm.imag * wm.imag
     uv = u * v
@@ -259,7 +333,12 @@ def _pair_near(ai, bi, aj, bj, Li, Lj, u, v, wm, logR):
     J0 = -s0 / uv
     J1 = -(s1 + 0.5 * uv * LL) / (uv * v)
     J1r = -(s1r + 0.5 * uv * LL) / (uv * u)
-    return I, J0, J1 / Lj, -J0, J1r / Li
+    # (Q1): conj Q = -(u v)^(-1) sum s_c |w_c|^2 l_c + c (u v)^(-2) sum s_c w_c^2 l_c
+    #                + c L_i L_j / (u v),  c = Re(u conj(v))
+    c = (u * v.conjugate()).real
+    iuv = uv.conjugate()              # 1 / (u v), |u v| = 1
+    Q = (iuv * (c * (iuv * sv + LL) - sq)).conjugate()
+    return I, J0, J1 / Lj, -J0, J1r / Li, Q
 
 
 def _order_thresholds(n_max: int, tol: float) -> np.ndarray:
@@ -286,7 +365,7 @@ if not QMAX[N_SERIES] > max(Q_NEAR, Q_SMOOTH):
 
 @njit(cache=True)
 def _pair_far(Li, Lj, u, v, wm, logR, ap, bp):
-    """The same five values as :func:`_pair_near` by the truncated series (module doc);
+    """The same six values as :func:`_pair_near` by the truncated series (module doc);
     ``ap``, ``bp``: scratch for the powers of a and b."""
     r2m = wm.real * wm.real + wm.imag * wm.imag
     iw = wm.conjugate() / r2m                    # 1 / w_m
@@ -327,7 +406,10 @@ def _pair_far(Li, Lj, u, v, wm, logR, ap, bp):
     I = LL * (0.5 * math.log(r2m) - logR + sv.real)
     J0 = (LL * iw) * s0
     h = (0.5 * LL) * iw
-    return I, J0, h * s1, -J0, -(h * s1r)
+    # (Q2): Q = L_i L_j (w_m / conj w_m) [conj(s0) + a conj(s1r) + b conj(s1)]
+    Q = (LL * wm * iw.conjugate()) * (s0.conjugate() + a * s1r.conjugate()
+                                      + b * s1.conjugate())
+    return I, J0, h * s1, -J0, -(h * s1r), Q
 
 
 @njit(cache=True, nogil=True)
@@ -348,12 +430,16 @@ def _element_data(nodes, elements):
 
 
 @njit(cache=True, nogil=True)
-def _vk_rows(zs, ze, L, dirs, nodes, elements, vdofs, wdofs, logR, V, K, R, direct, rows):
+def _vk_rows(zs, ze, L, dirs, nodes, elements, vdofs, wdofs, logR, V, K, Qm, R, direct,
+             rows):
     """V (symmetric) and K (W_hp x V_hp) of a mesh with all degrees 1 for the test
     elements i in ``rows``, over the pairs j > i: each gives V_ij = V_ji and the K entries
     of (i, j) (row i) and of (j, i) (row j).  ``direct``: the latter are added to K;
     otherwise stored in R[w_j, 2 i + r] (r = 0, 1 the ends of E_i) for :func:`_gather`, so
-    that several threads (disjoint ``rows``) never add to one entry."""
+    that several threads (disjoint ``rows``) never add to one entry.  If ``Qm`` is not
+    empty (W_hp x W_hp, complex), also Q_ij = Q_ji of (Q1), (Q2) (u^2 L_i L_j exactly for
+    collinear pairs, the identical pair included)."""
+    want_q = Qm.shape[0] > 0
     ne = elements.shape[0]
     ap = np.empty(N_SERIES + 1, np.complex128)
     bp = np.empty(N_SERIES + 1, np.complex128)
@@ -362,6 +448,8 @@ def _vk_rows(zs, ze, L, dirs, nodes, elements, vdofs, wdofs, logR, V, K, R, dire
         wi = wdofs[i]
         # identical pair: I = L^2 (log L - 3/2); K = 0 (collinear)
         V[wi, wi] = -INV_2PI * Li * Li * (math.log(Li) - logR - 1.5)
+        if want_q:
+            Qm[wi, wi] = (u * u) * (Li * Li)
         for j in range(i + 1, ne):
             aj, bj, Lj, v = zs[j], ze[j], L[j], dirs[j]
             # differences of nearby nodes first (exact, Sterbenz): w_m to relative eps
@@ -369,12 +457,18 @@ def _vk_rows(zs, ze, L, dirs, nodes, elements, vdofs, wdofs, logR, V, K, R, dire
             h = 0.5 * (Li + Lj)
             r = abs(wm)
             if h >= Q_NEAR * r and (h >= Q_SMOOTH * r or not _smooth_pair(u, v, wm, r)):
-                I, J0, J1, J0r, J1r = _pair_near(ai, bi, aj, bj, Li, Lj, u, v, wm, logR)
+                I, J0, J1, J0r, J1r, Q = _pair_near(ai, bi, aj, bj, Li, Lj, u, v, wm, logR)
             else:
-                I, J0, J1, J0r, J1r = _pair_far(Li, Lj, u, v, wm, logR, ap, bp)
+                I, J0, J1, J0r, J1r, Q = _pair_far(Li, Lj, u, v, wm, logR, ap, bp)
             wj = wdofs[j]
             V[wi, wj] = -INV_2PI * I
             V[wj, wi] = V[wi, wj]
+            if want_q:
+                if _on_line(nodes[elements[i, 0]], nodes[elements[i, 1]],
+                            nodes[elements[j, 0]], v.imag, -v.real):
+                    Q = (u * u) * (Li * Lj)
+                Qm[wi, wj] = Q
+                Qm[wj, wi] = Q
             # K of (test i, trial j) and of (test j, trial i)
             ka, kb = _k_entries(nodes[elements[i, 0]], nodes[elements[i, 1]],
                                 nodes[elements[j, 0]], v, J0, J1)
@@ -434,27 +528,30 @@ def applies(mesh) -> bool:
     return bool(np.all(mesh.degrees == 1))
 
 
-def laplace_p1_vk(W_space, V_space, scale: float):
-    """(V, K) of the Laplace operators (module doc of :mod:`hpfebe.bem.laplace`) on a mesh
-    with all degrees 1: V on W_space (P0) x W_space, K on W_space x V_space (P1), kernel
-    scale R = ``scale``, by the closed forms (V1), (K1) and the far-pair series.  Serial,
-    or on numba.get_num_threads() threads for large meshes (the same bits)."""
+def _check_p1(W_space, V_space, scale: float, who: str) -> float:
     mesh = W_space.mesh
     if V_space.mesh is not mesh:
         raise ValueError("W_space and V_space must live on the same mesh")
     if not applies(mesh):
-        raise ValueError("laplace_p1_vk needs all element degrees 1, got degrees "
+        raise ValueError(f"{who} needs all element degrees 1, got degrees "
                          f"{sorted(set(mesh.degrees.tolist()))}")
     scale = float(scale)
     if not (math.isfinite(scale) and scale > 0):
         raise ValueError(f"scale must be positive, got {scale!r}")
+    return scale
+
+
+def _p1_pass(W_space, V_space, scale: float, with_q: bool):
+    """(V, K, Q) of the Laplace closed forms in one pass (Q: None unless ``with_q``)."""
+    mesh = W_space.mesh
     ne = mesh.n_elements
     V = np.empty((W_space.ndof, W_space.ndof))
     K = np.zeros((W_space.ndof, V_space.ndof))
+    Q = np.empty((W_space.ndof, W_space.ndof) if with_q else (0, 0), np.complex128)
     vdofs = np.ascontiguousarray(V_space.elem_dofs[:, :2])
     wdofs = np.ascontiguousarray(W_space.elem_dofs[:, 0])
     geo = _element_data(mesh.nodes, mesh.elements)
-    args = (*geo, mesh.nodes, mesh.elements, vdofs, wdofs, math.log(scale), V, K)
+    args = (*geo, mesh.nodes, mesh.elements, vdofs, wdofs, math.log(scale), V, K, Q)
     nt = _n_threads(0.5 * ne * ne)
     if nt > 1:
         # rows of test elements on nt threads; the K entries of the pairs (j, i), j > i,
@@ -465,9 +562,20 @@ def laplace_p1_vk(W_space, V_space, scale: float):
         _threaded(_gather, (R, vdofs, wdofs, K), ne, nt)
     else:
         _vk_rows(*args, np.empty((0, 0)), True, np.arange(ne))
-    if not (np.all(np.isfinite(V)) and np.all(np.isfinite(K))):
+    if not (np.all(np.isfinite(V)) and np.all(np.isfinite(K))
+            and (not with_q or np.all(np.isfinite(Q)))):
         raise FloatingPointError("closed-form assembly produced non-finite entries "
                                  "(intersecting or degenerate elements?)")
+    return V, K, (Q if with_q else None)
+
+
+def laplace_p1_vk(W_space, V_space, scale: float):
+    """(V, K) of the Laplace operators (module doc of :mod:`hpfebe.bem.laplace`) on a mesh
+    with all degrees 1: V on W_space (P0) x W_space, K on W_space x V_space (P1), kernel
+    scale R = ``scale``, by the closed forms (V1), (K1) and the far-pair series.  Serial,
+    or on numba.get_num_threads() threads for large meshes (the same bits)."""
+    scale = _check_p1(W_space, V_space, scale, "laplace_p1_vk")
+    V, K, _ = _p1_pass(W_space, V_space, scale, False)
     return V, K
 
 
@@ -511,4 +619,115 @@ def laplace_p1_w(V: np.ndarray, W_space, V_space) -> np.ndarray:
         raise ValueError(f"V must have shape {(W_space.ndof, W_space.ndof)}, got {V.shape}")
     W = np.zeros((V_space.ndof, V_space.ndof))
     _w_from_v(V, np.ascontiguousarray(V_space.elem_dofs[:, :2]), mesh.lengths, W)
+    return W
+
+
+@njit(cache=True, nogil=True)
+def _lame_rows(Vl, Q, Kl, Ld, va, vb, cst, V, Vt, K, rows):
+    """Rows 2 e, 2 e + 1 (e in ``rows``, W_hp dofs) of the Lame V, Vt (L1) and K (L2)
+    from the Laplace V_Laplace = ``Vl``, K_Laplace = ``Kl`` and Q, with ``Ld`` the element
+    lengths, ``va``, ``vb`` the V_hp dofs of the start and end of each W_hp dof's element
+    (T[f, va[f]] = -1/L_f, T[f, vb[f]] = 1/L_f) and ``cst`` = (2 pi c1, c1 c2, 2 pi Et,
+    Et, alpha, beta).  K must be zero on entry (rows of several threads are disjoint)."""
+    fv, gv, ft, gt, alpha, beta = cst[0], cst[1], cst[2], cst[3], cst[4], cst[5]
+    hv = 0.5 * gv
+    ht = 0.5 * gt
+    n = Vl.shape[0]
+    nv = Kl.shape[1]
+    for e in rows:
+        r0 = 2 * e
+        r1 = r0 + 1
+        for f in range(n):
+            vl = Vl[e, f]
+            qr = Q[e, f].real
+            qi = Q[e, f].imag
+            ll = 0.5 * (Ld[e] * Ld[f])
+            c0 = 2 * f
+            d = fv * vl + gv * ll
+            V[r0, c0] = d + hv * qr
+            V[r1, c0 + 1] = d - hv * qr
+            V[r0, c0 + 1] = hv * qi
+            V[r1, c0] = hv * qi
+            d = ft * vl + gt * ll
+            Vt[r0, c0] = d + ht * qr
+            Vt[r1, c0 + 1] = d - ht * qr
+            Vt[r0, c0 + 1] = ht * qi
+            Vt[r1, c0] = ht * qi
+            # C_ef / L_f, C = -alpha V_Laplace J - beta Q_b J (module doc, (L2))
+            il = 1.0 / Ld[f]
+            k00 = (beta * qi) * il
+            k01 = (-alpha * vl - beta * qr) * il
+            k10 = (alpha * vl - beta * qr) * il
+            a = va[f]
+            if a >= 0:
+                K[r0, 2 * a] -= k00
+                K[r0, 2 * a + 1] -= k01
+                K[r1, 2 * a] -= k10
+                K[r1, 2 * a + 1] += k00
+            b = vb[f]
+            if b >= 0:
+                K[r0, 2 * b] += k00
+                K[r0, 2 * b + 1] += k01
+                K[r1, 2 * b] += k10
+                K[r1, 2 * b + 1] -= k00
+        for k in range(nv):
+            K[r0, 2 * k] += Kl[e, k]
+            K[r1, 2 * k + 1] += Kl[e, k]
+
+
+def lame_p1(W_space, V_space, kp, scale: float):
+    """(V, K, Vt) of the Lame operators (module doc of :mod:`hpfebe.bem.lame`:
+    G = c1 {-log(r/R) I + c2 r r^T/r^2}, Vt = Et {-log(r/R) I + r r^T/r^2}) on a mesh with
+    all degrees 1, interleaved components, from one pass of the Laplace closed forms
+    with Q (module doc, "Lame"): V and Vt by (L1), K by the Guenter representation (L2)
+    from the Laplace K, V and Q and the P1 derivative matrix T.  ``kp``: the kernel
+    parameters of :func:`hpfebe.bem.lame.kernel_params` (lambda, mu, c1, c2, Et; lambda*
+    in plane stress) for the scale R = ``scale``."""
+    scale = _check_p1(W_space, V_space, scale, "lame_p1")
+    kp = np.asarray(kp, dtype=float)
+    if kp.shape != (KP_LAME_SIZE,) or not np.all(np.isfinite(kp)):
+        raise ValueError(f"kp must be the {KP_LAME_SIZE} finite Lame kernel parameters "
+                         f"(lame.kernel_params), got {kp!r}")
+    lam, mu = kp[KP_LAMBDA], kp[KP_MU]
+    if not (mu > 0 and lam + mu > 0):
+        raise ValueError(f"kp: the Lame constants need mu > 0 and lambda + mu > 0, got "
+                         f"lambda = {lam!r}, mu = {mu!r}")
+    mesh = W_space.mesh
+    Vl, Kl, Q = _p1_pass(W_space, V_space, scale, True)
+    n, nv = W_space.ndof, V_space.ndof
+    wd = W_space.elem_dofs[:, 0]
+    Ld = np.empty(n)
+    Ld[wd] = mesh.lengths
+    va = np.full(n, -1, np.int64)
+    vb = np.full(n, -1, np.int64)
+    va[wd] = V_space.elem_dofs[:, 0]
+    vb[wd] = V_space.elem_dofs[:, 1]
+    lp2 = lam + 2.0 * mu
+    cst = np.array([2.0 * math.pi * kp[KP_C1], kp[KP_C1_C2], 2.0 * math.pi * kp[KP_ET],
+                    kp[KP_ET], mu / lp2, (lam + mu) / (4.0 * math.pi * lp2)])
+    V = np.empty((2 * n, 2 * n))
+    Vt = np.empty((2 * n, 2 * n))
+    K = np.zeros((2 * n, 2 * nv))
+    args = (Vl, Q, Kl, Ld, va, vb, cst, V, Vt, K)
+    nt = _n_threads(n * n)
+    if nt > 1:
+        _threaded(_lame_rows, args, n, nt)
+    else:
+        _lame_rows(*args, np.arange(n))
+    return V, K, Vt
+
+
+def lame_p1_w(Vt: np.ndarray, W_space, V_space) -> np.ndarray:
+    """The Lame hypersingular operator W = T^T Vt T (interleaved, V_hp^2 x V_hp^2) of a
+    mesh with all degrees 1 from Vt (W_hp^2 x W_hp^2, 2 x 2 blocks symmetric and
+    Vt_ef = Vt_fe): per component pair the scalar :func:`laplace_p1_w` of the symmetric
+    block Vt[k::2, l::2] (Vt_01 = Vt_10)."""
+    n, nv = W_space.ndof, V_space.ndof
+    Vt = np.asarray(Vt, dtype=float)
+    if Vt.shape != (2 * n, 2 * n):
+        raise ValueError(f"Vt must have shape {(2 * n, 2 * n)}, got {Vt.shape}")
+    W = np.empty((2 * nv, 2 * nv))
+    for k, l in ((0, 0), (1, 1), (0, 1)):
+        W[k::2, l::2] = laplace_p1_w(Vt[k::2, l::2], W_space, V_space)
+    W[1::2, 0::2] = W[0::2, 1::2]
     return W
