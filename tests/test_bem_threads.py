@@ -11,6 +11,7 @@ from hpfebe import BoundaryMesh
 from hpfebe.bem import LameBEM, LaplaceBEM, assembly
 from hpfebe.bem.kernels import LAPLACE_DL, LAPLACE_SL
 from hpfebe.bem.laplace import NO_LOG, SINGLE_LAYER_LOGC
+from hpfebe.bem.threads import interleaved
 
 pytestmark = pytest.mark.skipif(numba.config.NUMBA_NUM_THREADS < 2,
                                 reason="needs NUMBA_NUM_THREADS >= 2")
@@ -86,7 +87,7 @@ def test_threaded_chunks_cover_rows_once(monkeypatch):
     seen = []
     monkeypatch.setattr(assembly, "MIN_PAIRS_PER_THREAD", 1)
     _with_threads(2, assembly._threaded, lambda c: seen.append(np.array(c)), (),
-                  assembly._interleaved(101), 1e9, assembly.ROW_CHUNKS_PER_THREAD)
+                  interleaved(101), 1e9, assembly.ROW_CHUNKS_PER_THREAD)
     assert len(seen) == 2 * assembly.ROW_CHUNKS_PER_THREAD
     assert np.array_equal(np.sort(np.concatenate(seen)), np.arange(101))
 

@@ -11,7 +11,7 @@ import pytest
 from skfem import Basis
 
 from hpfebe.adaptivity.bem_estimator import lame_bem_indicators, lame_boundary_residuals
-from hpfebe.bem import LaplaceBEM, potentials
+from hpfebe.bem import LaplaceBEM, potentials, threads
 from hpfebe.bem.lame import LameBEM
 from hpfebe.coupling import NitscheFEBE, problem
 from hpfebe.coupling.errors import (be_domain_errors, be_domain_errors_both,
@@ -61,7 +61,7 @@ def test_threads_give_the_same_bits(monkeypatch):
     pts = _points(300)
     one = potentials.evaluate_potential(potentials.POT_LAPLACE_DL, op.kp, 1, pts,
                                         op.V_space, c)
-    monkeypatch.setattr(potentials.numba, "get_num_threads", lambda: 3)
+    monkeypatch.setattr(threads.numba, "get_num_threads", lambda: 3)
     monkeypatch.setattr(potentials, "MIN_PAIRS_PER_THREAD", 1)
     three = potentials.evaluate_potential(potentials.POT_LAPLACE_DL, op.kp, 1, pts,
                                           op.V_space, c)

@@ -22,7 +22,7 @@ import numpy as np
 import pytest
 
 from hpfebe import BoundaryMesh
-from hpfebe.bem import LameBEM, LaplaceBEM, assembly
+from hpfebe.bem import LameBEM, LaplaceBEM, assembly, threads
 from hpfebe.bem.kernels import LAPLACE_DL, LAPLACE_SL
 from hpfebe.bem.laplace import NO_LOG, SINGLE_LAYER_LOGC
 
@@ -124,7 +124,7 @@ def test_two_thread_speedup(benchmark, N):
     old = numba.get_num_threads()
     try:
         best = _min_interleaved({1: lambda: run(1), 2: lambda: run(2)},
-                                repeat=3 if N <= 1024 else 1)
+                                repeat=9 if N <= 1024 else 1)
     finally:
         numba.set_num_threads(old)
     # cpu/wall of the 2-thread run below ~1.8: the machine did not give this process two
@@ -141,27 +141,18 @@ _POOLS: list = []     # the _SerialPool instances of one run
 
 
 class _SerialPool:
-    """Stand-in for assembly's ThreadPoolExecutor: runs each task at once, on this
+    """Stand-in for the pool of hpfebe.bem.threads: runs each task at once, on this
     thread, and records its CPU time (thread_time: what a busy machine hardly disturbs)."""
 
     def __init__(self, max_workers):
         self.workers, self.tasks = max_workers, []
         _POOLS.append(self)
 
-    def __enter__(self):
-        return self
-
-    def __exit__(self, *exc):
-        return False
-
     def submit(self, fn, *args):
         t = time.thread_time()
         value = fn(*args)
         self.tasks.append(time.thread_time() - t)
         return types.SimpleNamespace(result=lambda: value)
-
-    def map(self, fn, *iterables):
-        return [self.submit(fn, *a).result() for a in zip(*iterables)]
 
     def makespan(self) -> float:
         """Time of the tasks on ``workers`` threads, each taking the next task when free."""
@@ -181,7 +172,7 @@ def test_two_thread_balance(benchmark, N, monkeypatch):
     if numba.config.NUMBA_NUM_THREADS < 2:
         pytest.skip("needs NUMBA_NUM_THREADS >= 2")
     old = numba.get_num_threads()
-    monkeypatch.setattr(assembly, "ThreadPoolExecutor", _SerialPool)
+    monkeypatch.setattr(threads, "executor", _SerialPool)
     mesh = _square(N)
     best = None
     try:

@@ -27,11 +27,9 @@ import gc
 import math
 import threading
 import types
-from concurrent.futures import ThreadPoolExecutor
 from contextlib import contextmanager
 from functools import lru_cache
 
-import numba
 import numpy as np
 from numba import njit
 
@@ -40,6 +38,7 @@ from ..spaces import P_MAX, DiscontinuousSpace, eval_basis, gll_tables, n_local
 from .integration import (ETA, NMAX, TOL, adjacent_block, coincident_block, far_block,
                           nearest_ends)
 from .kernels import INV_2PI, KP_LAPLACE_LOG_R, LAPLACE_DL, LAPLACE_SL, kernel_batch
+from .threads import interleaved, n_threads, run_chunks, zeros_aligned
 
 
 @njit(cache=True)
@@ -302,33 +301,21 @@ def _mirror_rows(A, blocks):
 MIN_PAIRS_PER_THREAD = 4096   # below this many element pairs one thread is faster
 
 
-def _interleaved(n: int) -> np.ndarray:
-    """0, n-1, 1, n-2, ...: short and long rows of a triangle alternate (load balance)."""
-    idx = np.arange(n)
-    return np.where(idx % 2 == 0, idx // 2, n - 1 - idx // 2)
-
-
 def _n_threads(work: float) -> int:
-    """Threads for ``work`` element pairs: numba.get_num_threads(), or 1 if the work is
-    too small to pay for threads (below MIN_PAIRS_PER_THREAD per thread)."""
-    nt = numba.get_num_threads()
-    return 1 if nt <= 1 or work < MIN_PAIRS_PER_THREAD * nt else nt
+    return n_threads(work, MIN_PAIRS_PER_THREAD)
 
 
 def _threaded(fn, args, items: np.ndarray, work: float, per_thread: int = 4) -> None:
-    """fn(*args, chunk) over chunks of ``items`` on numba.get_num_threads() threads (the
+    """fn(*args, chunk) over chunks of ``items`` on the threads of :mod:`.threads` (the
     nogil kernels write disjoint rows); one direct call when ``work`` (element pairs) is
-    too small to pay for threads.  NUMBA_NUM_THREADS / numba.set_num_threads pin it.
-    ``per_thread`` chunks per thread, each a run of ``items``, taken by the threads as
-    they become free (dynamic: rows of uneven cost balance)."""
+    too small to pay for threads.  ``per_thread`` chunks per thread, each a run of
+    ``items``, taken by the threads as they become free."""
     nt = min(_n_threads(work), len(items))
     if nt <= 1:
         fn(*args, items)
         return
-    chunks = np.array_split(items, min(len(items), per_thread * nt))
-    with ThreadPoolExecutor(max_workers=nt) as pool:
-        for f in [pool.submit(fn, *args, c) for c in chunks]:
-            f.result()
+    run_chunks(lambda c: fn(*args, c), np.array_split(items, min(len(items), per_thread * nt)),
+               nt)
 
 
 ROW_CHUNKS_PER_THREAD = 8   # row chunks per thread (taken dynamically) in assemble
@@ -340,8 +327,11 @@ def _rows_chunk(args, out, rows):
 
 
 def _rows_finite(A: np.ndarray, lo: int, hi: int) -> bool:
-    """Whether the rows lo <= r < hi of A are all finite (numpy releases the GIL)."""
-    return bool(np.isfinite(A[lo:hi]).all())
+    """Whether the rows lo <= r < hi of A are all finite (numpy releases the GIL): by
+    their min and max (NaN propagates), which allocate nothing - np.isfinite's boolean
+    temporary cost page faults that two threads could not share (issue 14)."""
+    B = A[lo:hi]
+    return bool(B.size == 0 or (np.isfinite(B.min()) and np.isfinite(B.max())))
 
 
 def _all_finite(A: np.ndarray) -> bool:
@@ -352,13 +342,12 @@ def _all_finite(A: np.ndarray) -> bool:
     if nt <= 1:
         return _rows_finite(A, 0, n)
     cuts = np.linspace(0, n, nt + 1).round().astype(np.int64)
-    with ThreadPoolExecutor(max_workers=nt) as pool:
-        return all(pool.map(_rows_finite, [A] * nt, cuts[:-1], cuts[1:]))
+    return all(run_chunks(lambda k: _rows_finite(A, cuts[k], cuts[k + 1]), range(nt), nt))
 
 
 def _mirror_upper(A: np.ndarray) -> None:
     nb = (A.shape[0] + 63) // 64
-    _threaded(_mirror_rows, (A,), _interleaved(nb), 0.5 * A.shape[0] ** 2 / 64)
+    _threaded(_mirror_rows, (A,), interleaved(nb), 0.5 * A.shape[0] ** 2 / 64)
 
 
 @lru_cache(maxsize=None)
@@ -494,7 +483,7 @@ def assemble(kernel: int, logc, kp, test, trial, d: int = 1,
     kp = np.ascontiguousarray(np.asarray(kp, dtype=float).reshape(-1))
     kt, degt, dofs_t = _space_arrays(test)
     kr, degr, dofs_r = _space_arrays(trial)
-    out = np.zeros((test.ndof * d, trial.ndof * d))
+    out = zeros_aligned((test.ndof * d, trial.ndof * d))
     nodes, elements = mesh.nodes, mesh.elements
     with _first_call(_element_geometry):
         normals, L, mid = _element_geometry(nodes, elements)
@@ -518,7 +507,7 @@ def assemble(kernel: int, logc, kp, test, trial, d: int = 1,
     else:
         with _first_call(_assemble_rows_serial):      # (gc thresholds: per process)
             _threaded(_rows_chunk, (args, out),
-                      _interleaved(ne) if symmetric else np.arange(ne), work,
+                      interleaved(ne) if symmetric else np.arange(ne), work,
                       per_thread=ROW_CHUNKS_PER_THREAD)
         if symmetric:
             # dofs of W_hp grow with the element index, so the pairs j >= i filled the
@@ -626,12 +615,12 @@ def sandwich(T, V: np.ndarray) -> np.ndarray:
         R.sort_indices()
         indptr, indices, data = R.indptr, R.indices, R.data
     n = T.shape[1]
-    out = np.empty((n, n))
+    out = zeros_aligned((n, n))
     V = np.ascontiguousarray(V)
     if _n_threads(0.5 * n * n) <= 1:
         _sandwich_rows(indptr, indices, data, V, out, True, np.arange(n))
     else:
-        _threaded(_sandwich_rows, (indptr, indices, data, V, out, False), _interleaved(n),
+        _threaded(_sandwich_rows, (indptr, indices, data, V, out, False), interleaved(n),
                   0.5 * n * n)
         _mirror_upper(out)
     return out

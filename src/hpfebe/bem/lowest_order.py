@@ -152,14 +152,13 @@ unordered element pairs, on several threads for large meshes with the same bits
 from __future__ import annotations
 
 import math
-from concurrent.futures import ThreadPoolExecutor
 from math import comb
 
-import numba
 import numpy as np
 from numba import njit
 
 from .kernels import KP_C1, KP_C1_C2, KP_ET, KP_LAMBDA, KP_LAME_SIZE, KP_MU
+from .threads import interleaved, n_threads, run_chunks, zeros_aligned
 
 INV_2PI = 1.0 / (2.0 * math.pi)
 
@@ -507,20 +506,14 @@ MIN_PAIRS_PER_THREAD = 32768  # below this many element pairs per thread: one th
 
 
 def _n_threads(work: float) -> int:
-    """Threads for ``work`` element pairs: numba.get_num_threads(), or 1 when too few."""
-    nt = numba.get_num_threads()
-    return 1 if work < MIN_PAIRS_PER_THREAD * nt else nt
+    return n_threads(work, MIN_PAIRS_PER_THREAD)
 
 
 def _threaded(fn, args, n: int, nt: int) -> None:
     """fn(*args, rows) over chunks of the rows 0..n-1 (interleaved: short and long rows of
-    the triangle alternate, 4 chunks per thread) on ``nt`` Python threads (``fn``
-    releases the GIL)."""
-    idx = np.arange(n)
-    order = np.where(idx % 2 == 0, idx // 2, n - 1 - idx // 2)
-    with ThreadPoolExecutor(max_workers=nt) as pool:
-        for f in [pool.submit(fn, *args, c) for c in np.array_split(order, 4 * nt)]:
-            f.result()
+    the triangle alternate, 4 chunks per thread) on ``nt`` threads (:mod:`.threads`;
+    ``fn`` releases the GIL)."""
+    run_chunks(lambda c: fn(*args, c), np.array_split(interleaved(n), 4 * nt), nt)
 
 
 def applies(mesh) -> bool:
@@ -545,9 +538,9 @@ def _p1_pass(W_space, V_space, scale: float, with_q: bool):
     """(V, K, Q) of the Laplace closed forms in one pass (Q: None unless ``with_q``)."""
     mesh = W_space.mesh
     ne = mesh.n_elements
-    V = np.empty((W_space.ndof, W_space.ndof))
-    K = np.zeros((W_space.ndof, V_space.ndof))
-    Q = np.empty((W_space.ndof, W_space.ndof) if with_q else (0, 0), np.complex128)
+    V = zeros_aligned((W_space.ndof, W_space.ndof))
+    K = zeros_aligned((W_space.ndof, V_space.ndof))
+    Q = zeros_aligned((W_space.ndof, W_space.ndof) if with_q else (0, 0), np.complex128)
     vdofs = np.ascontiguousarray(V_space.elem_dofs[:, :2])
     wdofs = np.ascontiguousarray(W_space.elem_dofs[:, 0])
     geo = _element_data(mesh.nodes, mesh.elements)
@@ -617,7 +610,7 @@ def laplace_p1_w(V: np.ndarray, W_space, V_space) -> np.ndarray:
     V = np.ascontiguousarray(V, dtype=float)
     if V.shape != (W_space.ndof, W_space.ndof):
         raise ValueError(f"V must have shape {(W_space.ndof, W_space.ndof)}, got {V.shape}")
-    W = np.zeros((V_space.ndof, V_space.ndof))
+    W = zeros_aligned((V_space.ndof, V_space.ndof))
     _w_from_v(V, np.ascontiguousarray(V_space.elem_dofs[:, :2]), mesh.lengths, W)
     return W
 
@@ -705,9 +698,9 @@ def lame_p1(W_space, V_space, kp, scale: float):
     lp2 = lam + 2.0 * mu
     cst = np.array([2.0 * math.pi * kp[KP_C1], kp[KP_C1_C2], 2.0 * math.pi * kp[KP_ET],
                     kp[KP_ET], mu / lp2, (lam + mu) / (4.0 * math.pi * lp2)])
-    V = np.empty((2 * n, 2 * n))
-    Vt = np.empty((2 * n, 2 * n))
-    K = np.zeros((2 * n, 2 * nv))
+    V = zeros_aligned((2 * n, 2 * n))
+    Vt = zeros_aligned((2 * n, 2 * n))
+    K = zeros_aligned((2 * n, 2 * nv))
     args = (Vl, Q, Kl, Ld, va, vb, cst, V, Vt, K)
     nt = _n_threads(n * n)
     if nt > 1:
@@ -726,7 +719,7 @@ def lame_p1_w(Vt: np.ndarray, W_space, V_space) -> np.ndarray:
     Vt = np.asarray(Vt, dtype=float)
     if Vt.shape != (2 * n, 2 * n):
         raise ValueError(f"Vt must have shape {(2 * n, 2 * n)}, got {Vt.shape}")
-    W = np.empty((2 * nv, 2 * nv))
+    W = zeros_aligned((2 * nv, 2 * nv))
     for k, l in ((0, 0), (1, 1), (0, 1)):
         W[k::2, l::2] = laplace_p1_w(Vt[k::2, l::2], W_space, V_space)
     W[1::2, 0::2] = W[0::2, 1::2]

@@ -24,10 +24,8 @@ Example 2 (50,181 points x 1,040 elements, single thread): SL 7.2 -> 1.6 s, DL 8
 from __future__ import annotations
 
 import math
-from concurrent.futures import ThreadPoolExecutor
 from functools import lru_cache
 
-import numba
 import numpy as np
 from numba import njit
 
@@ -36,6 +34,7 @@ from .assembly import rules
 from .integration import _order, point_panels
 from .kernels import (INV_2PI, KP_C1, KP_C1_C2, KP_C1_LOG_R, KP_C2, KP_LAMBDA,
                       KP_LAPLACE_LOG_R, KP_MU, _log_rr, _traction_of_G)
+from .threads import n_threads, run_chunks
 
 # potential kernel ids; kp is the parameter array of the owning operator class
 POT_LAME_SL, POT_LAME_DL, POT_LAME_SL_GRAD, POT_LAME_DL_GRAD = 0, 1, 2, 3
@@ -372,14 +371,11 @@ def _potential(kid, kp, d, nout, pts, mesh, space, coef, gx, gw, gll_x, gll_b):
             space.kind, space.elem_dofs, coef, gx, gw, gll_x, gll_b, nf, off, Y, FV, thr2,
             out)
     rows = np.arange(npts)
-    nt = min(numba.get_num_threads(), npts)
-    if nt <= 1 or npts * ne < MIN_PAIRS_PER_THREAD * nt:
+    nt = min(n_threads(npts * ne, MIN_PAIRS_PER_THREAD), npts)
+    if nt <= 1:
         _potential_rows(*args, rows, *tail)
         return out
-    with ThreadPoolExecutor(max_workers=nt) as pool:
-        for f in [pool.submit(_potential_rows, *args, c, *tail)
-                  for c in np.array_split(rows, 4 * nt)]:
-            f.result()
+    run_chunks(lambda c: _potential_rows(*args, c, *tail), np.array_split(rows, 4 * nt), nt)
     return out
 
 
