@@ -19,56 +19,12 @@ from hpfebe.bem.lowest_order import (
     laplace_p1_vk,
 )
 
-SQUARE = [(0, 0), (1, 0), (1, 1), (0, 1)]
+from p1_meshes import MESHES as ALL_MESHES
+from p1_meshes import SQUARE, graded, rel
 
-
-def _slit(d):
-    return BoundaryMesh.polygon([(0, 0), (2, 0), (2, 1), (1 + d, 1), (1 + d, 0.2),
-                                 (1, 0.2), (1, 1), (0, 1)], h=0.25, p=1)
-
-
-def _graded(levels):
-    """L-shape refined `levels` times at the re-entrant corner (sizes 1 ... 2^-levels)."""
-    m = BoundaryMesh.polygon([(0, 0), (2, 0), (2, 2), (1, 2), (1, 1), (0, 1)], n=2, p=1)
-    for _ in range(levels):
-        d = np.hypot(*(0.5 * (m.a + m.b) - np.array([1.0, 1.0])).T)
-        m = m.refine(np.flatnonzero(d <= d.min() * 1.0001))
-    return m
-
-
-def _acute(deg):
-    t = math.radians(deg)
-    return BoundaryMesh.polygon([(0, 0), (1, 0), (math.cos(t), math.sin(t))], n=[8, 1, 8],
-                                p=1)
-
-
-def _annulus():
-    """Square with a square hole (two closed curves), 8 elements per side."""
-    nodes = [(0, 0), (3, 0), (3, 3), (0, 3), (1, 1), (2, 1), (2, 2), (1, 2)]
-    seg = [(0, 1), (1, 2), (2, 3), (3, 0), (4, 5), (5, 6), (6, 7), (7, 4)]
-    m = BoundaryMesh.from_segments(nodes, seg)
-    for _ in range(3):
-        m = m.refine()
-    return m
-
-
-MESHES = {
-    "square16": lambda: BoundaryMesh.polygon(SQUARE, n=4, p=1),
-    "square64": lambda: BoundaryMesh.polygon(SQUARE, n=16, p=1),
-    "square256": lambda: BoundaryMesh.polygon(SQUARE, n=64, p=1),
-    "L-shape": lambda: BoundaryMesh.polygon([(0, 0), (2, 0), (2, 1), (1, 1), (1, 2),
-                                             (0, 2)], n=8, p=1),
-    "slit-1e-2": lambda: _slit(1e-2),
-    "slit-1e-8": lambda: _slit(1e-8),
-    "acute-3deg": lambda: _acute(3.0),
-    "graded-12": lambda: _graded(12),
-    "annulus": _annulus,
-}
-
-
-def _rel(A, B):
-    A, B = np.asarray(A), np.asarray(B)
-    return np.abs(A - B).max() / np.abs(B).max()
+MESHES = {k: ALL_MESHES[k] for k in ("square16", "square64", "square256", "L-shape",
+                                     "slit-1e-2", "slit-1e-8", "wedge-3deg", "graded-12",
+                                     "annulus")}
 
 
 @pytest.mark.parametrize("scale", [None, 1.0])
@@ -80,7 +36,7 @@ def test_matches_general_path(name, scale):
     ref = LaplaceBEM(mesh, scale=scale, closed_form=False)
     assert fast.closed_form and not ref.closed_form
     for k in "VKW":
-        assert _rel(getattr(fast, k), getattr(ref, k)) <= 1e-13, k
+        assert rel(getattr(fast, k), getattr(ref, k)) <= 1e-13, k
 
 
 def test_collinear_adjacent_closed_form():
@@ -102,7 +58,7 @@ def test_collinear_adjacent_closed_form():
     assert op.K[i].any() and op.K[j].any()
 
 
-@pytest.mark.parametrize("name", ["square64", "acute-3deg", "slit-1e-8", "graded-12"])
+@pytest.mark.parametrize("name", ["square64", "wedge-3deg", "slit-1e-8", "graded-12"])
 def test_gauss_identity_and_symmetry(name):
     """(K + 1/2) 1 = 0 on a closed curve: the row sums of K are -|E_i| / 2; V symmetric."""
     mesh = MESHES[name]()
@@ -113,7 +69,8 @@ def test_gauss_identity_and_symmetry(name):
 
 @pytest.mark.parametrize("q", [0.9 * Q_NEAR, 0.5 * Q_NEAR, 0.2 * Q_NEAR])
 def test_series_matches_closed_form(q):
-    """Far-pair series and the closed form agree (independent formulas) on random pairs
+    """Far-pair series and the closed form agree (independent formulas: (V1), (K1), (Q1)
+    against their series, module doc) on random pairs
     at (L_i + L_j) / (2 |w_m|) = q, to the closed form's cancellation error ~ eps / q^3
     (of J1; measured 2.5e-13 relative to L_i L_j / |w_m| at q = 0.11, 1.2e-12 at q =
     0.05: why the closed form is used only for q >= Q_NEAR)."""
@@ -129,10 +86,14 @@ def test_series_matches_closed_form(q):
         aj, bj = -0.5 * Lj * v, 0.5 * Lj * v
         near = _pair_near(ai, bi, aj, bj, Li, Lj, u, v, wm, 0.3)
         far = _pair_far(Li, Lj, u, v, wm, 0.3, ap, bp)
+        # (I, J0, J1, J0', J1'; Q of the Lame operators: its corner sum (Q1) loses less,
+        # measured 5.8e-15, 1.1e-14, 2.4e-14 of L_i L_j at q = 0.225, 0.125, 0.05)
         scale = (Li * Lj, Li * Lj / abs(wm), Li * Lj / abs(wm), Li * Lj / abs(wm),
-                 Li * Lj / abs(wm))
-        for n, f, s in zip(near, far, scale):
-            assert abs(n - f) <= 1e-15 / q ** 3 * s
+                 Li * Lj / abs(wm), Li * Lj)
+        tol = (1e-15 / q ** 3,) * 5 + (4e-15 / q,)
+        assert len(near) == len(far) == len(scale)
+        for n, f, s, t in zip(near, far, scale, tol):
+            assert abs(n - f) <= t * s
 
 
 def test_dispatch_and_input_checks():
@@ -163,7 +124,7 @@ def test_threads_bitwise(monkeypatch):
 
     if numba.config.NUMBA_NUM_THREADS < 2:
         pytest.skip("needs NUMBA_NUM_THREADS >= 2")
-    mesh = _graded(6)
+    mesh = graded(6)
     old = numba.get_num_threads()
     try:
         numba.set_num_threads(1)
@@ -191,9 +152,9 @@ def test_smooth_curve():
                                                        (np.arange(256) + 1) % 256]))
     fast = LaplaceBEM(mesh)
     ref = LaplaceBEM(mesh, closed_form=False)
-    assert _rel(fast.V, ref.V) <= 1e-13
-    assert _rel(fast.K, ref.K) <= 1e-13
-    assert _rel(fast.W, ref.W) <= 3e-13
+    assert rel(fast.V, ref.V) <= 1e-13
+    assert rel(fast.K, ref.K) <= 1e-13
+    assert rel(fast.W, ref.W) <= 3e-13
 
 
 @pytest.mark.parametrize("short", [1e-6, 1e-9, 1e-12])

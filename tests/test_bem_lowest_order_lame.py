@@ -13,92 +13,11 @@ from hpfebe import BoundaryMesh
 from hpfebe.bem import LameBEM, LaplaceBEM
 from hpfebe.bem.lame import kernel_params
 from hpfebe.bem.lowest_order import (
-    N_SERIES,
-    Q_NEAR,
     _p1_pass,
-    _pair_far,
-    _pair_near,
     lame_p1,
     lame_p1_w,
 )
-
-SQUARE = [(0, 0), (1, 0), (1, 1), (0, 1)]
-
-
-def _slit(d):
-    return BoundaryMesh.polygon([(0, 0), (2, 0), (2, 1), (1 + d, 1), (1 + d, 0.2),
-                                 (1, 0.2), (1, 1), (0, 1)], h=0.25, p=1)
-
-
-def _graded(levels):
-    """L-shape refined ``levels`` times at the re-entrant corner."""
-    m = BoundaryMesh.polygon([(0, 0), (2, 0), (2, 2), (1, 2), (1, 1), (0, 1)], n=2, p=1)
-    for _ in range(levels):
-        d = np.hypot(*(0.5 * (m.a + m.b) - np.array([1.0, 1.0])).T)
-        m = m.refine(np.flatnonzero(d <= d.min() * 1.0001))
-    return m
-
-
-def _wedge(deg):
-    t = math.radians(deg)
-    return BoundaryMesh.polygon([(0, 0), (1, 0), (math.cos(t), math.sin(t))], n=[8, 1, 8],
-                                p=1)
-
-
-def _star(k=5):
-    r = np.where(np.arange(2 * k) % 2 == 0, 1.0, 0.4)
-    t = np.pi * np.arange(2 * k) / k
-    return BoundaryMesh.polygon(np.column_stack([r * np.cos(t), r * np.sin(t)]), n=3, p=1)
-
-
-def _ngon(n):
-    th = 2 * np.pi * np.arange(n) / n
-    return BoundaryMesh.from_segments(np.column_stack([np.cos(th), np.sin(th)]),
-                                      np.column_stack([np.arange(n), (np.arange(n) + 1) % n]))
-
-
-def _curves(nodes, seg, refine):
-    m = BoundaryMesh.from_segments(nodes, seg)
-    for _ in range(refine):
-        m = m.refine()
-    return m
-
-
-def _annulus():
-    """Square with a square hole (two closed curves)."""
-    return _curves([(0, 0), (3, 0), (3, 3), (0, 3), (1, 1), (2, 1), (2, 2), (1, 2)],
-                   [(0, 1), (1, 2), (2, 3), (3, 0), (4, 5), (5, 6), (6, 7), (7, 4)], 3)
-
-
-def _near_touching(gap=1e-7):
-    """Two unit squares side by side, ``gap`` apart (two closed curves)."""
-    x = 1.0 + gap
-    return _curves([(0, 0), (1, 0), (1, 1), (0, 1), (x, 0), (x + 1, 0), (x + 1, 1), (x, 1)],
-                   [(0, 1), (1, 2), (2, 3), (3, 0), (4, 5), (5, 6), (6, 7), (7, 4)], 3)
-
-
-def _tiny_beside_collinear(short=1e-9):
-    return BoundaryMesh.polygon([(0, 0), (1, 0), (1, short), (1, 1), (0, 1)],
-                                n=[4, 1, 3, 4, 4], p=1)
-
-
-MESHES = {
-    "square16": lambda: BoundaryMesh.polygon(SQUARE, n=4, p=1),
-    "square64": lambda: BoundaryMesh.polygon(SQUARE, n=16, p=1),
-    "square256": lambda: BoundaryMesh.polygon(SQUARE, n=64, p=1),
-    "L-shape": lambda: BoundaryMesh.polygon([(0, 0), (2, 0), (2, 1), (1, 1), (1, 2),
-                                             (0, 2)], n=8, p=1),
-    "slit-1e-2": lambda: _slit(1e-2),
-    "slit-1e-5": lambda: _slit(1e-5),
-    "slit-1e-8": lambda: _slit(1e-8),
-    "wedge-3deg": lambda: _wedge(3.0),
-    "star": _star,
-    "graded-12": lambda: _graded(12),
-    "256-gon": lambda: _ngon(256),
-    "annulus": _annulus,
-    "near-touching": _near_touching,
-    "tiny-1e-9": _tiny_beside_collinear,
-}
+from p1_meshes import MESHES, SQUARE, graded, ngon, rel, star
 
 # (E, nu, plane, scale); scale None: the default 2 x diameter
 MATERIALS = [(1.0, 0.3, "strain", None), (266926.0, 0.49, "stress", 1.0),
@@ -106,17 +25,12 @@ MATERIALS = [(1.0, 0.3, "strain", None), (266926.0, 0.49, "stress", 1.0),
              (1.0, 0.49, "strain", 1.0)]
 
 
-def _rel(A, B):
-    A, B = np.asarray(A), np.asarray(B)
-    return np.abs(A - B).max() / np.abs(B).max()
-
-
 def _check(mesh, E, nu, plane, scale, tol=1e-13, tol_w=1e-13):
     fast = LameBEM(mesh, E, nu, plane, scale=scale)
     ref = LameBEM(mesh, E, nu, plane, scale=scale, closed_form=False)
     assert fast.closed_form and not ref.closed_form
     for k in ("V", "K", "Vt", "W", "S_hat"):
-        assert _rel(getattr(fast, k), getattr(ref, k)) <= (
+        assert rel(getattr(fast, k), getattr(ref, k)) <= (
             tol_w if k in ("W", "S_hat") else tol), k
     return fast, ref
 
@@ -141,7 +55,7 @@ def test_smooth_curve_1024():
     against mpmath's tanh-sinh quadrature (30 digits) is off by 1.5e-14 of max |Vt| in
     the general path and by 1.3e-16 in the closed form."""
     mp = pytest.importorskip("mpmath")
-    mesh = _ngon(1024)
+    mesh = ngon(1024)
     fast, ref = _check(mesh, 1.0, 0.3, "strain", None, tol_w=6e-13)
     i, j = 100, 101
     z = mesh.nodes @ np.array([1.0, 1j])
@@ -183,26 +97,7 @@ def test_guenter_representation_of_the_double_layer():
         IJ = np.kron(np.eye(n), np.array([[0.0, 1.0], [-1.0, 0.0]]))
         K = (np.kron(lap.K, np.eye(2))
              + (np.kron(lap.V, np.eye(2)) - 2 * lame.mu * lame.V) @ IJ @ lame.T.toarray())
-        assert _rel(K, lame.K) <= 1e-13
-
-
-@pytest.mark.parametrize("q", [0.9 * Q_NEAR, 0.5 * Q_NEAR, 0.2 * Q_NEAR])
-def test_q_series_matches_corner_sum(q):
-    """Q = int int w / conj(w): the far-pair series (Q2) and the corner sum (Q1) agree on
-    random pairs at (L_i + L_j) / (2 |w_m|) = q to the corner sum's cancellation error
-    (measured 5.8e-15, 1.1e-14, 2.4e-14 of L_i L_j at q = 0.225, 0.125, 0.05)."""
-    rng = np.random.default_rng(7)
-    ap = np.empty(N_SERIES + 1, np.complex128)
-    bp = np.empty(N_SERIES + 1, np.complex128)
-    for _ in range(50):
-        Li, Lj = rng.uniform(0.2, 1.0, 2)
-        u, v = np.exp(2j * np.pi * rng.random(2))
-        wm = 0.5 * (Li + Lj) / q * np.exp(2j * np.pi * rng.random())
-        ai, bi = wm - 0.5 * Li * u, wm + 0.5 * Li * u
-        aj, bj = -0.5 * Lj * v, 0.5 * Lj * v
-        near = _pair_near(ai, bi, aj, bj, Li, Lj, u, v, wm, 0.3)
-        far = _pair_far(Li, Lj, u, v, wm, 0.3, ap, bp)
-        assert abs(near[5] - far[5]) <= 4e-15 / q * Li * Lj
+        assert rel(K, lame.K) <= 1e-13
 
 
 def test_q_against_gauss_quadrature():
@@ -246,7 +141,7 @@ def test_collinear_q_exact():
 def test_rigid_motions():
     """(K + M/2) kills the three rigid motions (interior Calderon identity with zero
     traction), W too, exactly in exact arithmetic: 1e-14 relative on a star."""
-    op = LameBEM(_star(), 1.0, 0.3)
+    op = LameBEM(star(), 1.0, 0.3)
     X = np.column_stack([op.V_space.interpolate(lambda x: x[:, 0]),
                          op.V_space.interpolate(lambda x: x[:, 1])])
     R = np.zeros((2 * len(X), 3))
@@ -291,7 +186,7 @@ def test_threads_bitwise(monkeypatch):
 
     if numba.config.NUMBA_NUM_THREADS < 2:
         pytest.skip("needs NUMBA_NUM_THREADS >= 2")
-    op = LameBEM(_graded(6), 1.0, 0.3)
+    op = LameBEM(graded(6), 1.0, 0.3)
     old = numba.get_num_threads()
     try:
         numba.set_num_threads(1)
