@@ -11,6 +11,7 @@ from hpfebe import BoundaryMesh
 from hpfebe.bem import LameBEM, LaplaceBEM, assembly
 from hpfebe.bem.kernels import LAPLACE_DL, LAPLACE_SL
 from hpfebe.bem.laplace import NO_LOG, SINGLE_LAYER_LOGC
+from hpfebe.bem import threads
 from hpfebe.bem.threads import interleaved
 
 pytestmark = pytest.mark.skipif(numba.config.NUMBA_NUM_THREADS < 2,
@@ -69,17 +70,17 @@ def test_threads_bitwise_lame(monkeypatch):
 
 
 def test_threaded_finiteness_check(monkeypatch):
-    monkeypatch.setattr(assembly, "MIN_PAIRS_PER_THREAD", 1)
-    A = np.zeros((300, 200))
-    for nt in (1, 2):
-        assert _with_threads(nt, assembly._all_finite, A)
-        for bad in (np.nan, np.inf, -np.inf):
-            B = A.copy()
-            B[299, 199] = bad
-            assert not _with_threads(nt, assembly._all_finite, B)
-            B = A.copy()
-            B[0, 0] = bad
-            assert not _with_threads(nt, assembly._all_finite, B)
+    monkeypatch.setattr(threads, "MIN_ENTRIES_PER_THREAD", 1)
+    for A in (np.zeros((300, 200)), np.zeros((300, 200), complex)):
+        for nt in (1, 2):
+            assert _with_threads(nt, threads.all_finite, A)
+            for bad in (np.nan, np.inf, -np.inf, complex(0, np.nan), complex(np.inf, 0)):
+                if not np.iscomplexobj(A) and isinstance(bad, complex):
+                    continue
+                for r, c in ((299, 199), (0, 0)):
+                    B = A.copy()
+                    B[r, c] = bad
+                    assert not _with_threads(nt, threads.all_finite, B)
 
 
 def test_threaded_chunks_cover_rows_once(monkeypatch):

@@ -38,7 +38,7 @@ from ..spaces import P_MAX, DiscontinuousSpace, eval_basis, gll_tables, n_local
 from .integration import (ETA, NMAX, TOL, adjacent_block, coincident_block, far_block,
                           nearest_ends)
 from .kernels import INV_2PI, KP_LAPLACE_LOG_R, LAPLACE_DL, LAPLACE_SL, kernel_batch
-from .threads import interleaved, n_threads, run_chunks, zeros_aligned
+from .threads import all_finite, interleaved, n_threads, run_chunks, zeros_aligned
 
 
 @njit(cache=True)
@@ -326,25 +326,6 @@ def _rows_chunk(args, out, rows):
     _assemble_rows_serial(*args, out, rows, np.array([0, len(rows)], dtype=np.int64))
 
 
-def _rows_finite(A: np.ndarray, lo: int, hi: int) -> bool:
-    """Whether the rows lo <= r < hi of A are all finite (numpy releases the GIL): by
-    their min and max (NaN propagates), which allocate nothing - np.isfinite's boolean
-    temporary cost page faults that two threads could not share (issue 14)."""
-    B = A[lo:hi]
-    return bool(B.size == 0 or (np.isfinite(B.min()) and np.isfinite(B.max())))
-
-
-def _all_finite(A: np.ndarray) -> bool:
-    """np.all(np.isfinite(A)) for a dense matrix, in row blocks on the threads (as a
-    serial step it was 3 % of V + K + W at N = 4096 on 2 threads, issue 14)."""
-    nt = _n_threads(A.size / 64)
-    n = A.shape[0]
-    if nt <= 1:
-        return _rows_finite(A, 0, n)
-    cuts = np.linspace(0, n, nt + 1).round().astype(np.int64)
-    return all(run_chunks(lambda k: _rows_finite(A, cuts[k], cuts[k + 1]), range(nt), nt))
-
-
 def _mirror_upper(A: np.ndarray) -> None:
     nb = (A.shape[0] + 63) // 64
     _threaded(_mirror_rows, (A,), interleaved(nb), 0.5 * A.shape[0] ** 2 / 64)
@@ -513,7 +494,7 @@ def assemble(kernel: int, logc, kp, test, trial, d: int = 1,
             # dofs of W_hp grow with the element index, so the pairs j >= i filled the
             # upper triangle
             _mirror_upper(out)
-    if not _all_finite(out):
+    if not all_finite(out):
         raise FloatingPointError("assembly produced non-finite entries "
                                  "(degenerate geometry or degree too high?)")
     return out

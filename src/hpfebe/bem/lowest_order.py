@@ -158,7 +158,7 @@ import numpy as np
 from numba import njit
 
 from .kernels import KP_C1, KP_C1_C2, KP_ET, KP_LAMBDA, KP_LAME_SIZE, KP_MU
-from .threads import interleaved, n_threads, run_chunks, zeros_aligned
+from .threads import all_finite, interleaved, n_threads, run_chunks, zeros_aligned
 
 INV_2PI = 1.0 / (2.0 * math.pi)
 
@@ -555,8 +555,7 @@ def _p1_pass(W_space, V_space, scale: float, with_q: bool):
         _threaded(_gather, (R, vdofs, wdofs, K), ne, nt)
     else:
         _vk_rows(*args, np.empty((0, 0)), True, np.arange(ne))
-    if not (np.all(np.isfinite(V)) and np.all(np.isfinite(K))
-            and (not with_q or np.all(np.isfinite(Q)))):
+    if not (all_finite(V) and all_finite(K) and all_finite(Q)):
         raise FloatingPointError("closed-form assembly produced non-finite entries "
                                  "(intersecting or degenerate elements?)")
     return V, K, (Q if with_q else None)
