@@ -62,6 +62,24 @@ def test_dtn_default_tolerances_close_to_monolithic(scene, mono):
     assert first(rd["P_l2_prev"]) == first(rd["P_l2_new"]) == sol.info.iterations
 
 
+@pytest.mark.parametrize("omega_N", [0.3, 0.7])
+def test_tangential_increments_contract_by_one_minus_omega_N(scene, omega_N):
+    """Where the stamp slides, step 6 relaxes the tangential traction alone: the
+    tangential part of P^k - P^k-1 shrinks by exactly 1 - omega_N per DtN iteration,
+    whatever omega_D does, and bounds the printed stopping rule from below."""
+    sol = scene.dtn(0.5, omega_N, tol=1e-8)
+    assert sol.info.converged, sol.info.reason
+    # every contact node slides (|lambda| = 1) but the middle one (x = 0, symmetry)
+    lam = np.abs(sol.lam)
+    assert np.all((lam >= 1 - 1e-12) | (lam <= 1e-9)) and np.sum(lam <= 1e-9) == 1
+    rd = sol.info.counts["readings"]
+    t = np.asarray(rd["P_t_l2_prev"])[1:]
+    a = (t * np.asarray(sol.info.counts["P_norms"])[: t.size])[t > 1e-9]
+    assert a.size >= 4
+    assert np.abs(a[1:] / a[:-1] - (1 - omega_N)).max() <= 1e-6
+    assert np.all(np.asarray(rd["P_t_l2_prev"]) <= np.asarray(rd["P_l2_prev"]))
+
+
 def test_divergence_detected(scene):
     sol = scene.dtn(0.9, 1.0, max_iter=30)
     assert not sol.info.converged

@@ -62,8 +62,13 @@ SIDES = ("bottom", "right", "top", "left")
 #: coefficient vector, L2(Gamma_C) of the function M2^-1 P, the elastic energy norm of
 #: U2, U2 on Gamma^2_C) and the reference (the previous iterate - the printed rule -, the
 #: new one - :func:`hpfebe.nonlinear.fixed_point`'s -, or the first nonzero P).
+#: "P_t_l2_prev" is no reading but a bound: the tangential components of P's increment
+#: alone, relative to ||P^k-1|| (<= P_l2_prev: the printed rule cannot stop before it
+#: falls below TOL).  Where the stamp slides, step 6 relaxes the tangential traction
+#: alone (R1_t = F w lambda, |lambda| = 1, does not change), so this quantity contracts by
+#: exactly 1 - omega_N per iteration.
 READINGS = ("P_l2_prev", "P_l2_new", "P_max_prev", "P_L2gamma_prev", "P_l2_first",
-            "U2_l2_prev", "U2_max_prev", "U2_energy_prev", "U2_contact_prev")
+            "U2_l2_prev", "U2_max_prev", "U2_energy_prev", "U2_contact_prev", "P_t_l2_prev")
 
 
 # --------------------------------------------------------------------------- traces
@@ -233,6 +238,8 @@ class FEMortarContact(MortarContact):
                                            space1, space2, "full")
         self.c1 = _vector_dofs(stamp, vert1[m.dofs1])    # FE dofs of body 1 on Gamma^1_C
         self.c2 = _vector_dofs(work.elastic, vert2[m.dofs2])  # ... of body 2 on Gamma^2_C
+        # the tangential component of an interleaved vector on Gamma^2_C (a straight side)
+        self.t2 = 0 if contact2 in ("top", "bottom") else 1
         fixed1, vals1 = _dirichlet(stamp, dirichlet1, "dirichlet1")
         self.fixed2, self.values2 = _dirichlet(work.elastic, dirichlet2, "dirichlet2")
         if np.intersect1d(fixed1, self.c1).size or np.intersect1d(self.fixed2, self.c2).size:
@@ -356,7 +363,8 @@ class FEMortarContact(MortarContact):
         ``info.steps[k]``: the inner SolverInfo of DtN iteration k + 1, its ``counts``
         the Uzawa and Newton iterations; ``info.counts["relative_increments"]``: the
         quantity of the stopping test, ||P_k+1 - P_k|| / ||P_k+1||, per iteration (the
-        run stopped at a looser TOL is its first entry <= TOL).  ``extra``: the FE
+        run stopped at a looser TOL is its first entry <= TOL), ``P_norms`` the
+        ||P_k+1||.  ``extra``: the FE
         vectors ``u1``, ``u2``, the force of step 2 on body 2 ``force2`` and the work
         piece's stress fields (:meth:`work_fields`)."""
         _check_omega("omega_D", omega_D)
@@ -417,7 +425,7 @@ class FEMortarContact(MortarContact):
             newton_total=int(sum(s.counts.get("newton", 0) for s in info.steps)),
             rho=rho, relative_increments=[
                 r / max(n, np.finfo(float).tiny) for r, n in zip(info.residuals, st["pn"])],
-            readings=st["readings"])
+            readings=st["readings"], P_norms=st["pn"])
         u2 = st["u2"] if st["u2"] is not None else self.elastic_start(
             np.zeros(self.work.ndofs))
         if info.converged:                       # U2 of the final P (step 2 once more)
@@ -465,6 +473,8 @@ class FEMortarContact(MortarContact):
         out["P_max_prev"].append(rel(np.abs(dP).max(), np.abs(P_old).max()))
         out["P_L2gamma_prev"].append(rel(l2_gamma(dP), l2_gamma(P_old)))
         out["P_l2_first"].append(rel(np.linalg.norm(dP), np.linalg.norm(P_first)))
+        out["P_t_l2_prev"].append(rel(np.linalg.norm(dP.reshape(-1, 2)[:, self.t2]),
+                                      np.linalg.norm(P_old)))
         if u2_old is None:
             for k in ("U2_l2_prev", "U2_max_prev", "U2_energy_prev", "U2_contact_prev"):
                 out[k].append(np.inf)
