@@ -61,7 +61,10 @@ class ContactSettings:
     "MMD_AT_PLUS_A" is ~1.7x faster per factorisation than SuperLU's default "COLAMD",
     with other round-off: measured, the iteration counts of the unloading increments
     and the load path of a hard increment (a step cut or not) change, and with them
-    the results of those runs by up to 1e-4 .. 3e-2 relative)."""
+    the results of those runs by up to 1e-4 .. 3e-2 relative).  ``two_pass``: the
+    symmetric two-pass penalty contact of :class:`TwoBodyContact` (a second pass with
+    the stamp and the work piece swapped; contact stiffness about 2/eps_n on a flat
+    interface, the single pass at eps/2 there); False = the thesis's single pass."""
 
     eps_n_factor: float = 10.0
     eps_t_factor: float = 5.0
@@ -72,6 +75,7 @@ class ContactSettings:
     predictor: bool = True
     F: float | None = None
     lu_ordering: str = "COLAMD"
+    two_pass: bool = False
 
     def __post_init__(self):
         for name in ("eps_n_factor", "eps_t_factor", "rtol"):
@@ -87,6 +91,8 @@ class ContactSettings:
         if self.lu_ordering not in LU_ORDERINGS:
             raise ValueError(f"lu_ordering must be one of {LU_ORDERINGS}, got "
                              f"{self.lu_ordering!r}")
+        if not isinstance(self.two_pass, (bool, np.bool_)):
+            raise ValueError(f"two_pass must be a bool, got {self.two_pass!r}")
         if self.max_iter < 1 or self.max_cuts < 0:
             raise ValueError(f"max_iter must be >= 1 and max_cuts >= 0, got "
                              f"{self.max_iter!r}, {self.max_cuts!r}")
@@ -180,7 +186,8 @@ def _stamp_on_work(stamp, body, E: float, settings: ContactSettings):
     the work piece's bottom (``is_y`` marks the lifted y components)."""
     pr = TwoBodyContact(stamp, body, "bottom", "top",
                         eps_n=1.0 / (settings.eps_n_factor * E),
-                        eps_t=1.0 / (settings.eps_t_factor * E), **settings.friction())
+                        eps_t=1.0 / (settings.eps_t_factor * E), **settings.friction(),
+                        two_pass=bool(settings.two_pass))
     return (pr, *pr.stamp_dofs())
 
 

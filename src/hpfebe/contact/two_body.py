@@ -63,6 +63,32 @@ and the consistent tangent K + G_n^T W_n G_n + G_t^T (W_t G_t - W_tn G_n) (G_n, 
 sparse maps U -> dg_n, dg_t at the points, W the diagonal law derivatives of
 :class:`hpfebe.contact.laws.LawState` times the weights): non-symmetric in slip.
 
+Single pass and two passes.  The construction above is one master-slave pass, the
+thesis's Section 4.2 formulation (the gap (4.18) at slave points, the master's normal):
+the default.  ``two_pass=True`` (two deformable bodies) adds the symmetric treatment of
+Laursen (Computational Contact and Impact Mechanics, Ch. 5) and Wriggers (Computational
+Contact Mechanics, two-pass node-to-segment): a second pass with the roles swapped,
+points on the master's contact segments (split at the projections of the slave
+vertices), projected onto the slave polyline, gap and slip along the slave's outward
+normal n_s and t_s = (n_s,y, -n_s,x),
+
+    g_n = (x_m + u_m - x_s - u_s) . n_s,     g_t = (u_m - u_s) . t_s,
+
+with the same eps_n, eps_t and law.  On a flat interface n_s = -n_m, t_s = -t_m, so at
+coinciding points both passes see the same g_n and the same physical slip g_t (the sign
+flips of the tangent and of the difference cancel).  Both passes integrate
+(approximately: exactly on a flat interface with the splits) the same interface, so the
+contact stiffness is about 2/eps_n and the penetration about half the single pass's at
+the same contact force; each pass carries about half the force (the physical traction is
+the sum of the passes').  On a flat interface the pass-1 points coincide with the pass-0
+points wherever both sides overlap (both passes integrate on the common refinement of
+the two interface meshes), with the same weights, gaps and slips, and the other points
+are ``outside``: the two-pass problem is then the single pass with eps_n/2, eps_t/2 up
+to rounding (measured on the Table 4.3 scene: max |dU| / max |U| = 2.7e-16); the two
+differ on curved or kinked interfaces.  Per-point arrays are concatenated, pass 0
+first; ``passes`` (here and in :class:`ContactResult`) marks each point's pass, e.g. the
+penetration on the slave side alone is integrated with ``weights * (passes == 0)``.
+
 A rigid obstacle as master (:class:`hpfebe.contact.bodies.RigidObstacle`): the points are
 Gauss points of the slave's contact elements, n_m = -n (n the slave's outward normal),
 t_m its tangent, g_n = g(x) - U_n, g_t = U_t - w(x): the one-body problems of Sections
@@ -195,6 +221,10 @@ class ContactResult:
     bound s), state (OPEN / STICK / SLIP), slip (g_t^p after the last converged step)
     load_vector, obstacle_motion : load and obstacle motion w of the last step (to
     continue loading with ``initial=``)
+    passes : the pass of each contact point (0: slave points on the master; 1, with
+    ``two_pass``: master points on the slave, whose ``elements`` are master facets);
+    ``weights * (passes == 0)`` integrates over the slave side only.  With two passes
+    ``total_forces`` sums both (the physical total force)
     """
 
     U: np.ndarray
@@ -216,6 +246,7 @@ class ContactResult:
     load_vector: np.ndarray = None
     obstacle_motion: np.ndarray = None
     friction: str = "coulomb"
+    passes: np.ndarray = None
 
     @property
     def steps(self) -> list:
@@ -280,11 +311,16 @@ class TwoBodyContact:
     quadrature : "gauss" (fixed points above) or "exact": a BE body against a rigid
         obstacle without friction, (U_n - g_h)_+ integrated exactly on the pieces where
         it is positive (:mod:`hpfebe.contact.positive_part`, Section 3.2)
+    two_pass : False (default) = one master-slave pass, the thesis's Section 4.2
+        formulation; True = the symmetric two-pass treatment (module doc: a second pass
+        with the bodies' roles swapped, contact stiffness about 2/eps_n on a flat
+        interface); two deformable bodies and quadrature "gauss" only
     """
 
     def __init__(self, slave, master, slave_boundary, master_boundary=None,
                  eps_n: float = None, eps_t: float = 1.0, mu_f: float = 0.0, F=None,
-                 nq: Optional[int] = 2, split: bool = True, quadrature: str = "gauss"):
+                 nq: Optional[int] = 2, split: bool = True, quadrature: str = "gauss",
+                 two_pass: bool = False):
         self.bodies = {"slave": as_body(slave, "slave"), "master": as_body(master, "master")}
         self.slave, self.master = slave, master
         if self.bodies["slave"].kind == "rigid":
@@ -299,6 +335,7 @@ class TwoBodyContact:
         self.nq = None if nq is None else int(nq)
         self.split = bool(split)
         sb, mb = self.bodies["slave"], self.bodies["master"]
+        self.two_pass = self._two_pass(two_pass, mb, quadrature)
         self.offset = sb.ndofs
         self.ndofs = sb.ndofs + mb.ndofs
         # (4.27) / (4.33): FE blocks sparse, a BE block (dense S_hat) inside; a system
@@ -306,12 +343,26 @@ class TwoBodyContact:
         self.dense = "FE" not in (sb.kind, mb.kind)
         if mb.kind == "rigid":
             self._build_rigid(slave_boundary)
+            self.passes = np.zeros(len(self.points), dtype=np.intp)
         else:
             self._build_contact(slave_boundary, master_boundary)
             self.motion = np.zeros(len(self.points))
         self.F = None if F is None else pointwise("F", F, self.points, allow_negative=False)
         self.law_name = "tresca" if F is not None else "coulomb"
         self.exact = self._exact_quadrature(quadrature, slave_boundary)
+
+    @staticmethod
+    def _two_pass(two_pass, master, quadrature) -> bool:
+        """Validated ``two_pass``: a bool, only for a deformable master and the fixed
+        Gauss points (the exact positive part is a one-body quadrature)."""
+        if not isinstance(two_pass, (bool, np.bool_)):
+            raise ValueError(f"two_pass must be a bool, got {two_pass!r}")
+        if two_pass and master.kind == "rigid":
+            raise ValueError("two_pass needs a deformable master (a rigid obstacle has no "
+                             "contact points of its own)")
+        if two_pass and quadrature == "exact":
+            raise ValueError("two_pass is not available with quadrature='exact'")
+        return bool(two_pass)
 
     def _exact_quadrature(self, quadrature: str, slave_boundary):
         if quadrature not in QUADRATURES:
@@ -369,28 +420,56 @@ class TwoBodyContact:
         self.Gn, self.Gt, self.tangents = _trace_maps(nm, sides, self.ndofs)
 
     def _build_contact(self, slave_boundary, master_boundary) -> None:
+        """Contact points of two deformable bodies: pass 0 (points on the slave's contact
+        segments, projected onto the master polyline, master normals); with ``two_pass``
+        also pass 1 (the roles swapped: points on the master's segments, slave normals).
+        Every per-point array is the concatenation of the passes (pass 0 first);
+        ``self.passes`` says which pass a point belongs to."""
         S, M = self.bodies["slave"], self.bodies["master"]
-        ssg = S.segments(slave_boundary)
-        msg = M.segments(master_boundary)
-        fs, xa, xb = ssg["ids"], ssg["a"], ssg["b"]
-        A, B, ma, mb = msg["a"], msg["b"], msg["va"], msg["vb"]
-        # integration segments: every slave segment is split where a master vertex
-        # projects onto it, so that slave and master traces are both polynomial on each
-        # piece (a BE trace of degree p needs p + 1 Gauss points per piece)
+        slave = (S, S.segments(slave_boundary), 0)
+        master = (M, M.segments(master_boundary), self.offset)
+        parts = [self._contact_pass(slave, master)]
+        if self.two_pass:
+            parts.append(self._contact_pass(master, slave))
+        for key in ("points", "weights", "outside", "master_points", "point_facets", "g0",
+                    "normals", "tangents"):
+            setattr(self, key, np.concatenate([q[key] for q in parts]))
+        for key in ("Gn", "Gt"):
+            setattr(self, key, parts[0][key] if len(parts) == 1
+                    else sp.vstack([q[key] for q in parts], format="csr"))
+        self.passes = np.concatenate([np.full(q["points"].shape[0], k, dtype=np.intp)
+                                      for k, q in enumerate(parts)])
+
+    def _contact_pass(self, point_side, target_side) -> dict:
+        """One master-slave pass (Section 4.2, the gap (4.18)): ``point_side`` = (body,
+        its contact segments, dof offset) carries the contact points, ``target_side`` the
+        polyline they are projected onto and whose outward normals n_T give the gap
+        g_n = (x_P + u_P - x_T - u_T) . n_T and slip g_t = (u_P - u_T) . t_T (traces with
+        sign +1 for the point body, -1 for the target).  Pass 0: (slave, master); pass 1
+        of ``two_pass``: (master, slave).  Returns the per-point arrays (points, weights,
+        outside, master_points = the projections x_T, point_facets = the point body's
+        facet/element ids, g0, normals, tangents, Gn, Gt)."""
+        P, psg, poff = point_side
+        T, tsg, toff = target_side
+        fs, xa, xb = psg["ids"], psg["a"], psg["b"]
+        A, B, ma, mb = tsg["a"], tsg["b"], tsg["va"], tsg["vb"]
+        # integration segments: every point segment is split where a target vertex
+        # projects onto it, so that both traces are polynomial on each piece (a BE trace
+        # of degree p needs p + 1 Gauss points per piece)
         mpts = np.vstack([A, B])
         mseg, ms, mexc, _ = project_onto_polyline(mpts, xa, xb)
         inner = (mexc == 0) & (ms > 1e-12) & (ms < 1 - 1e-12)
         if not self.split:
             inner[:] = False
         nq = 2 if self.nq is None else self.nq
-        if S.kind == "BE" or M.kind == "BE":
-            nq = max(nq, max(S.degree, M.degree) + 1)
+        if P.kind == "BE" or T.kind == "BE":
+            nq = max(nq, max(P.degree, T.degree) + 1)
         t, w = gauss_legendre(nq)
         t, w = np.asarray(t, dtype=float), np.asarray(w, dtype=float)
         pf, ps, pw = [], [], []
         for i in range(fs.size):
             br = np.unique(np.concatenate([[0.0, 1.0], ms[inner & (mseg == i)]]))
-            # drop breakpoints closer than rounding (a master vertex seen from two segments)
+            # drop breakpoints closer than rounding (a target vertex seen from two segments)
             br = br[np.concatenate([[True], np.diff(br) > 1e-12])]
             br[-1] = 1.0
             lo, hi = br[:-1], br[1:]
@@ -402,26 +481,23 @@ class TwoBodyContact:
         length = np.linalg.norm(xb - xa, axis=1)
         pts = xa[pf] + ps[:, None] * (xb[pf] - xa[pf])
         wts = pw * length[pf]
-        self.point_facets = fs[pf]
-        # master segments
-        normals = msg["normals"]
+        # target segments
         seg, s, excess, _ = project_onto_polyline(pts, A, B)
         seg_len = np.linalg.norm(B - A, axis=1)
-        # outside: clipped onto an end vertex of the master polyline (a vertex of one
-        # master segment only); clipped onto an inner corner vertex is a valid contact
-        verts, inv = np.unique(np.concatenate([ma, mb]), return_inverse=True)
+        # outside: clipped onto an end vertex of the target polyline (a vertex of one
+        # target segment only); clipped onto an inner corner vertex is a valid contact
+        _, inv = np.unique(np.concatenate([ma, mb]), return_inverse=True)
         counts = np.bincount(inv)
         vid = np.where(s < 0.5, inv[seg], inv[ma.size + seg])
         outside = (excess * seg_len[seg] > 1e-10 * seg_len.max()) & (counts[vid] == 1)
         xm = A[seg] + s[:, None] * (B[seg] - A[seg])
-        self.points = pts
-        self.weights = np.where(outside, 0.0, wts)
-        self.outside = outside
-        self.master_points = xm
-        nm = normals[seg]
-        self.g0 = np.sum((pts - xm) * nm, axis=1)
-        self._set_traces(nm, [(S, fs[pf], ps, 0, 1.0),
-                              (M, msg["ids"][seg], s, self.offset, -1.0)])
+        nm = tsg["normals"][seg]
+        Gn, Gt, tm = _trace_maps(nm, [(P, fs[pf], ps, poff, 1.0),
+                                      (T, tsg["ids"][seg], s, toff, -1.0)], self.ndofs)
+        return dict(points=pts, weights=np.where(outside, 0.0, wts), outside=outside,
+                    master_points=xm, point_facets=fs[pf],
+                    g0=np.sum((pts - xm) * nm, axis=1), normals=nm, tangents=tm,
+                    Gn=Gn, Gt=Gt)
 
     # ------------------------------------------------------------------ dof helpers
     def global_dofs(self, body: str, dofs: np.ndarray) -> np.ndarray:
@@ -655,4 +731,6 @@ class TwoBodyContact:
             weights=cs["weights"], g_n=cs["g_n"], g_t=cs["g_t"], p_n=cs["p_n"],
             t_t=cs["t_t"], bound=np.asarray(cs["law"].bound, dtype=float),
             state=cs["state"], slip=steps.slip, elements=cs["elements"],
-            load_vector=steps.f, obstacle_motion=steps.w, friction=self.law_name)
+            load_vector=steps.f, obstacle_motion=steps.w, friction=self.law_name,
+            passes=self.passes if self.exact is None
+            else np.zeros(cs["points"].shape[0], dtype=np.intp))
