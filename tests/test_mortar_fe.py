@@ -80,6 +80,17 @@ def test_tangential_increments_contract_by_one_minus_omega_N(scene, omega_N):
     assert np.all(np.asarray(rd["P_t_l2_prev"]) <= np.asarray(rd["P_l2_prev"]))
 
 
+def test_non_yielding_work_piece_is_solved():
+    """sigma_Y far beyond the small-strain range (an elastic work piece): the Newton
+    floor must not accept an undeformed work piece (it did with sigma_Y x h as floor)."""
+    sc = section44_scene((4, 8), (16, 8), sigma_Y=4e12, formulation="full")
+    sol = sc.dtn(0.5, 0.7)
+    assert sol.info.converged, sol.info.reason
+    assert sc.kkt_residual(sol)["equilibrium2"] <= 1e-7
+    assert sol.extra["fields"]["eps_p_norm_mean"].max() == 0
+    assert np.abs(sol.extra["u2"][0::2]).max() > 1e-7        # the work piece deforms
+
+
 def test_divergence_detected(scene):
     sol = scene.dtn(0.9, 1.0, max_iter=30)
     assert not sol.info.converged

@@ -50,6 +50,21 @@ def test_fe_and_be_stamps_agree_and_leave_a_dent():
     assert 0.5 * 4.2e-3 < dent < 1.1 * 4.2e-3
 
 
+def test_non_yielding_work_piece_is_solved():
+    """sigma_Y far beyond the small-strain range: the stopping test's floor (a
+    yield-level force, J2Material.stress_floor) must not accept an unsolved increment;
+    the work piece stays elastic, its reaction balances the stamp's, no dent is left."""
+    fe = work_piece(WORK, 0.4, J2Material(E, NU, 4e12, 450.0, 1.0))
+    tr = _touch("FE", fe)
+    assert tr.converged, tr.reason
+    assert tr.peak.fields["eps_p_norm"].max() == 0
+    f = np.array([r.force for r in tr.records])
+    assert np.all(np.diff(f[:4]) > 0) and abs(f[-1]) < 1e-6 * f[3]
+    c = tr.peak.result
+    assert abs(c.total_forces()[0] - f[3]) <= 1e-6 * f[3]     # contact force = reaction
+    assert np.abs(tr.u_work).max() <= 1e-6 * np.abs(tr.peak.u_work).max()    # no dent
+
+
 def test_second_touch_continues_the_history():
     mat = J2Material(E, NU, 4.0, 450.0, 0.0)
     fe = work_piece(WORK, 0.4, mat)

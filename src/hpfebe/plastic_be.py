@@ -487,12 +487,13 @@ class _CellStrainProblem:
     """The inner problem of :meth:`ElastoPlasticBE.implicit_response` for
     :func:`hpfebe.nonlinear.newton`: x = cell strains e (3 ncell), residual
     F(e) = e - b - M tau(RM(e)), merit ||F||^2 / 2, key = the plastic set; the scale of
-    the stopping test is max|e| + the yield strain sigma_Y / E."""
+    the stopping test is max|e| + the yield strain sigma_Y / E (sigma_Y capped at 1e-3 E,
+    :attr:`J2Material.stress_floor`)."""
 
     def __init__(self, body: "ElastoPlasticBE", M: np.ndarray, b: np.ndarray):
         self.body, self.M, self.b = body, M, b
         self.Cel = body.material.elastic_tangent()
-        self.eY = body.material.sigma_Y / body.material.E
+        self.eY = body.material.stress_floor / body.material.E
 
     def evaluate(self, e: np.ndarray) -> Iterate:
         body = self.body

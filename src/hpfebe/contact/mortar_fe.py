@@ -297,14 +297,17 @@ class FEMortarContact(MortarContact):
 
     @property
     def force_floor(self) -> float:
-        """sigma_Y x the shortest cell edge of body 2: the nodal force of a yield-level
-        traction, the absolute floor of the Newton stopping test (times its tolerance;
-        at a stress-free state, e.g. the rigid lift of the first DtN iteration, the
-        relative test alone would ask for round-off)."""
+        """:attr:`J2Material.stress_floor` (sigma_Y, at most 1e-3 E) x the shortest cell
+        edge of body 2: the nodal force of a yield-level traction, the absolute floor of
+        the Newton stopping test (times its tolerance; at a stress-free state, e.g. the
+        rigid lift of the first DtN iteration, the relative test alone would ask for
+        round-off).  Uncapped, sigma_Y = 4e12 gave a floor above every force of the
+        Section 4.4 scene: Newton accepted its start and DtN 'converged' to a work
+        piece that never deformed."""
         p = self.work.mesh.p
         f = self.work.mesh.facets
         h = float(np.linalg.norm(p[:, f[0]] - p[:, f[1]], axis=0).min())
-        return self.work.material.sigma_Y * h
+        return self.work.material.stress_floor * h
 
     def elastic_start(self, f_ext) -> np.ndarray:
         """The linear elastic response of body 2 to the prescribed values and the load

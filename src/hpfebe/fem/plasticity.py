@@ -110,6 +110,15 @@ class J2Material:
         return lame_constants(self.E, self.nu, "strain")[1]
 
     @property
+    def stress_floor(self) -> float:
+        """min(sigma_Y, 1e-3 E): the stress scale of the absolute floors of stopping
+        tests (a yield-level stress; capped at the stress of a 0.1 % strain, so that a
+        material that does not yield in the small-strain range - sigma_Y = 4e12, an
+        elastic check - does not get a floor above every force of the problem, which
+        let Newton accept its start)."""
+        return min(self.sigma_Y, 1e-3 * self.E)
+
+    @property
     def kappa(self) -> float:
         """Bulk modulus kappa = lambda + 2 mu / 3."""
         return self.lam + 2.0 * self.mu / 3.0
