@@ -62,13 +62,15 @@ SIDES = ("bottom", "right", "top", "left")
 #: coefficient vector, L2(Gamma_C) of the function M2^-1 P, the elastic energy norm of
 #: U2, U2 on Gamma^2_C) and the reference (the previous iterate - the printed rule -, the
 #: new one - :func:`hpfebe.nonlinear.fixed_point`'s -, or the first nonzero P).
+#: "P_n_l2_prev": the normal components of P alone (a test on the contact pressure).
 #: "P_t_l2_prev" is no reading but a bound: the tangential components of P's increment
 #: alone, relative to ||P^k-1|| (<= P_l2_prev: the printed rule cannot stop before it
 #: falls below TOL).  Where the stamp slides, step 6 relaxes the tangential traction
 #: alone (R1_t = F w lambda, |lambda| = 1, does not change), so this quantity contracts by
 #: exactly 1 - omega_N per iteration.
 READINGS = ("P_l2_prev", "P_l2_new", "P_max_prev", "P_L2gamma_prev", "P_l2_first",
-            "U2_l2_prev", "U2_max_prev", "U2_energy_prev", "U2_contact_prev", "P_t_l2_prev")
+            "U2_l2_prev", "U2_max_prev", "U2_energy_prev", "U2_contact_prev", "P_n_l2_prev",
+            "P_t_l2_prev")
 
 
 # --------------------------------------------------------------------------- traces
@@ -478,6 +480,8 @@ class FEMortarContact(MortarContact):
         out["P_l2_first"].append(rel(np.linalg.norm(dP), np.linalg.norm(P_first)))
         out["P_t_l2_prev"].append(rel(np.linalg.norm(dP.reshape(-1, 2)[:, self.t2]),
                                       np.linalg.norm(P_old)))
+        out["P_n_l2_prev"].append(rel(np.linalg.norm(dP.reshape(-1, 2)[:, 1 - self.t2]),
+                                      np.linalg.norm(P_old.reshape(-1, 2)[:, 1 - self.t2])))
         if u2_old is None:
             for k in ("U2_l2_prev", "U2_max_prev", "U2_energy_prev", "U2_contact_prev"):
                 out[k].append(np.inf)
