@@ -14,10 +14,12 @@ both methods; B-bar and the uniform h_work mesh as options); Coulomb friction mu
 0.2 with the penalty laws (4.19)-(4.20) (a comparison variant: the mortar's Tresca F in
 the penalty law, ``penalty_law``), 1/eps_n = 20, 10, 5, 2.5 x E_m and 1/eps_t
 half of that, Algorithm 4.1 (incremental loading, Newton with the consistent tangents
-(4.36)-(4.43)).  Reported: Newton iterations (total over the load increments) and the
-L2 norm of the penetration ([u_n] - g)_+ on Gamma_C (slave quadrature of
-:class:`hpfebe.contact.two_body.TwoBodyContact`) per penalty pair; Figure 4.22: u_x, u_y
-of both bodies and ||dev sigma_m|| with the colorbar ranges beside the published ones.
+(4.36)-(4.43)), the contact in two passes (each body the slave once, ``two_pass``;
+the single pass beside it).  Reported: Newton iterations (total over the load
+increments) and the L2 norm of the penetration ([u_n] - g)_+ on Gamma_C (the first
+pass's quadrature of :class:`hpfebe.contact.two_body.TwoBodyContact`) per penalty pair;
+Figure 4.22: u_x, u_y of both bodies and ||dev sigma_m|| with the colorbar ranges beside
+the published ones.
 
 Mortar (Table 4.2, Figure 4.21): pure FEM, Q1 in both bodies
 (:class:`hpfebe.contact.mortar_fe.FEMortarContact`), given (Tresca) friction F = 0.22,

@@ -369,9 +369,8 @@ class FEMortarContact(MortarContact):
         the Uzawa and Newton iterations; ``info.counts["relative_increments"]``: the
         quantity of the stopping test, ||P_k+1 - P_k|| / ||P_k+1||, per iteration (the
         run stopped at a looser TOL is its first entry <= TOL), ``P_norms`` the
-        ||P_k+1||.  ``extra``: the FE
-        vectors ``u1``, ``u2``, the force of step 2 on body 2 ``force2`` and the work
-        piece's stress fields (:meth:`work_fields`)."""
+        ||P_k+1||.  ``extra``: the FE vectors ``u1``, ``u2``, the force of step 2 on
+        body 2 ``force2`` and the work piece's stress fields (:meth:`work_fields`)."""
         _check_omega("omega_D", omega_D)
         _check_omega("omega_N", omega_N)
         _check_pos("rho", rho)
