@@ -350,7 +350,8 @@ class FEMortarContact(MortarContact):
            increment by ``divergence``, a failed Newton or Uzawa solve or ``max_iter``
            end it with the reason); converged only if also the obstacle matches the
            work piece, ||Q_n - (pi U2)_n||_inf <= ``coupling_tol`` ||(pi U2)_n||_inf
-           (``info.backward_error``).
+           (``info.backward_error``) and the work piece's equilibrium residual under P
+           (:meth:`kkt_residual`, ``equilibrium2``) is <= ``coupling_tol``.
 
         ``newton_tol``: the Newton tolerance of step 2 (||R||_inf <= newton_tol x (force
         scale + :attr:`force_floor`)); the thesis's TOL_N = 1e-4 in this norm leaves
@@ -449,9 +450,17 @@ class FEMortarContact(MortarContact):
                            f"coupling_tol = {coupling_tol:g}")
         x = st["x"] if st["x"] is not None else np.zeros(2 * self.nc)
         u1 = self.body1.expand(self.R.T @ x)
-        return MortarSolution(u1[self.c1], u2[self.c2], st["lam"], st["Q"], P, x, info,
-                              extra=dict(u1=u1, u2=u2, force2=load2(P),
-                                         fields=self.work_fields(u2)))
+        sol = MortarSolution(u1[self.c1], u2[self.c2], st["lam"], st["Q"], P, x, info,
+                             extra=dict(u1=u1, u2=u2, force2=load2(P),
+                                        fields=self.work_fields(u2)))
+        # backward error of step 2, independent of the Newton test and its floor: the
+        # returned U2 must carry the returned P
+        eq = self.kkt_residual(sol)["equilibrium2"] if info.converged else np.nan
+        if info.converged and not eq <= coupling_tol:
+            info.converged = False
+            info.reason = (f"no solution: the work piece's equilibrium residual {eq:.1e} "
+                           f"(relative) > coupling_tol = {coupling_tol:g}")
+        return sol
 
     def _record_readings(self, out: dict, P_old, P_new, P_first, u2_old, u2) -> None:
         """Append the relative increment of DtN iteration k under every reading of the
