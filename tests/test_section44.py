@@ -44,6 +44,11 @@ def test_table_4_3_quick(quick_run):
     assert np.all((ratio > 0.3) & (ratio < 4)), ratio
     meta = json.loads((quick_run / "table_4_3.json").read_text())
     assert len(meta["claims"]) >= 4
+    # the table's two-pass contact against the single pass beside it: on the flat
+    # interface two passes act like a doubled penalty, about half the penetration
+    single = meta["meta"]["other_passes_penetration"]
+    q = np.array([single[f"{f:g}"] for f in tab.inv_eps_n_over_E]) / pen
+    assert np.all((q > 1.5) & (q < 2.1)), q
 
 
 def test_figure_4_22_quick(quick_run):
