@@ -894,8 +894,7 @@ def tolerance_fit_claim(prm: Params, tab: pd.DataFrame, pub: pd.DataFrame,
     """(analysis) The relative stopping tolerance whose counts fit Table 4.2 best, from a
     scan of ``fit_tols`` on the same runs (their recorded relative increments of P):
     what the thesis's counts correspond to, beside the printed TOL_DtN."""
-    m = tab.merge(pub, on=["omega_D", "omega_N"], suffixes=("", "_pub"))
-    m = m[m.converged & m.dtn_iterations_pub.notna()]
+    m, _ = _reading_stats(prm, tab, pub)
     if m.empty:
         return Claim("(analysis) the relative tolerance that fits Table 4.2", None,
                      "no common converged cell")
