@@ -5,11 +5,18 @@
 #   snakemake -n                                   dry run: what would be (re)built
 #   snakemake --profile profiles/slurm             on a SLURM cluster
 #
-# One rule per experiment module in experiments/ (rule name = module name), generated
-# from the registry; each runs `python -m hpfebe run <first artefact>` and writes all
-# artefacts of its module to results/.  A change of the module file or of a config file
-# reruns it.  `rule report` builds report/index.html and report/report.md.
+# One rule per job, generated from the registry (experiments/registry.py): a job is a
+# scene of an experiment module (rule `<module>__<scene>`) or a module without scenes
+# (rule = module name); it runs `python -m hpfebe run <rule>` and writes the artefacts of
+# that scene to results/.  What reruns a job (and then the report):
+#   - its module file, or an experiments/ file the module imports, changed (mtime);
+#   - its module's config section, or quick/full, changed (params: the merged section);
+# nothing else: not another module's section, not README.md, not src/hpfebe (the core:
+# rerun what a core change affects with --forcerun RULE, or --forceall; every result
+# records the git commit it was built from).  `rule report` builds report/index.html and
+# report/report.md.
 
+import json
 import os
 import shlex
 import sys
@@ -18,7 +25,7 @@ from pathlib import Path
 configfile: "config/config.yaml"
 
 sys.path.insert(0, workflow.basedir)
-from experiments.registry import discover  # noqa: E402  (standard library only)
+from experiments.registry import discover, unknown_sections  # noqa: E402  (stdlib only)
 
 REGISTRY = discover(Path(workflow.basedir) / "experiments")
 RESULTS = "results"
@@ -26,18 +33,44 @@ LOGS = f"{RESULTS}/logs"
 QUICK = config.get("quick", False)
 if not isinstance(QUICK, bool):  # "false" is a non-empty string, not false
     raise ValueError(f"config key 'quick' must be true or false, got {QUICK!r}")
+for _key, _close in unknown_sections(config, [e.name for e in REGISTRY]):
+    if _close:   # a job sees only the files that set its own section: check them all here
+        raise ValueError(f"config section {_key!r} is not an experiment module; did you "
+                         f"mean {_close!r}?")
 
 # The config files in the order Snakemake merged them: config/config.yaml, then every
 # --configfile given on the command line.  The CLI merges them the same way.
 CONFIG_FILES = ["config/config.yaml"]
 for _f in workflow.config_settings.configfiles:
-    _f = Path(_f)
+    _f = Path(os.path.abspath(_f))       # relative to the working directory if inside it
     try:
-        _f = _f.resolve().relative_to(Path.cwd().resolve())
+        _f = _f.relative_to(os.path.abspath(Path.cwd()))
     except ValueError:
         pass
     if str(_f) not in CONFIG_FILES:
         CONFIG_FILES.append(str(_f))
+
+
+def _top_level_keys(f):
+    import yaml
+
+    with open(f, encoding="utf-8") as fh:
+        data = yaml.safe_load(fh) or {}
+    return set(data) if isinstance(data, dict) else set()
+
+
+_KEYS = {f: _top_level_keys(f) for f in CONFIG_FILES}
+
+
+def config_flags(exp):
+    """The job's config files: config/config.yaml and each further file that sets this
+    module's section or `quick` (a file that changes only other modules is not part of
+    this job's command, so adding it reruns only those).  The merged top level is
+    checked here, for every file: a misspelt section is an error."""
+    files = [f for i, f in enumerate(CONFIG_FILES)
+             if i == 0 or {exp.name, "quick"} & _KEYS[f]]
+    return " ".join((["--quick"] if QUICK else [])
+                    + [f"--config {shlex.quote(f)}" for f in files])
 
 # One thread per job (snakemake -j2 on 2 cores never oversubscribes): numba, OpenMP and
 # BLAS pools are pinned to the job's thread count.
@@ -48,9 +81,12 @@ PYTHON = shlex.quote(sys.executable)
 # Interrupted runs: every job watches the Snakemake process that started it (this one:
 # the Snakefile is read by it) and stops when it is gone, even after a SIGKILL, instead
 # of running on as an orphan that writes into results/; SIGTERM/SIGINT/SIGHUP to a job
-# remove its temporary files (hpfebe.cli.install_signal_handlers).  After an interrupted
-# run: `snakemake --unlock`, then rerun (see README, "Reliability").
-WATCH_ENV = f"HPFEBE_PARENT_PID={os.getpid()}"
+# remove its temporary files (hpfebe.cli.install_signal_handlers).  The pid reaches the
+# jobs through the environment they inherit, not through their command: a value that
+# changes on every call must not be part of a job's command, inputs or params (Snakemake
+# would rerun every job every time).  After an interrupted run: `snakemake --unlock`,
+# then rerun (see README, "Reliability").
+os.environ["HPFEBE_PARENT_PID"] = str(os.getpid())
 
 
 def artefact_outputs(artefacts):
@@ -65,25 +101,46 @@ def artefact_outputs(artefacts):
 ALL_RESULTS = [p for e in REGISTRY for p in artefact_outputs(e.artefacts)]
 
 # The numba kernels are compiled once, by the first job (`hpfebe compile`), and loaded
-# from numba's on-disk cache by every module that calls them (experiments/registry.py:
-# a module with NUMBA = False runs beside that job).  Without it the first two jobs of a
-# fresh machine compile the same kernels at once.  Only modules whose results are missing
-# wait for the stamp (a pure ordering: the stamp never makes a built module rerun).
+# from numba's on-disk cache by every job that calls them (experiments/registry.py: a
+# module with NUMBA = False runs beside that job).  Without it the first two jobs of a
+# fresh machine compile the same kernels at once.  The stamp is an `ancient` input of
+# every numba job, always (an input set that depended on the state of results/ made
+# every job rerun): it orders the first run and never makes a built job rerun.
 NUMBA_STAMP = f"{LOGS}/numba_cache.json"
 
 
-def waits_for_numba(exp):
-    return exp.numba and not all(Path(p).exists() for p in artefact_outputs(exp.artefacts))
+def numba_input(exp):
+    return [ancient(NUMBA_STAMP)] if exp.numba else []
 
 
-# Longest modules first (two jobs on two cores: the run ends when its longest module
-# does; the report's Timing table has the measured times).  Others get priority 0.
-LONGEST_FIRST = ["ch4_plasticity", "ch4_section44", "ch2_convergence", "ch4_mortar",
-                 "ch4_adaptive_fefe", "ch3_penalty_hp", "ch3_adaptive_bem"]
+# Longest jobs first (two jobs on two cores: the run ends when its longest job does):
+# the job's wall time measured by its last run (results/<artefact>.json), else the
+# figure recorded in config/job_times.yaml (tools/job_times.py writes it from a run).
+JOB_TIMES_FILE = Path(workflow.basedir) / "config" / "job_times.yaml"
 
 
-def priority_of(name):
-    return len(LONGEST_FIRST) - LONGEST_FIRST.index(name) if name in LONGEST_FIRST else 0
+def _job_times():
+    import yaml
+
+    recorded = {}
+    if JOB_TIMES_FILE.is_file():
+        recorded = (yaml.safe_load(JOB_TIMES_FILE.read_text()) or {}).get("wall_s", {})
+    times = {}
+    for job in REGISTRY.jobs:
+        try:
+            doc = json.loads(Path(f"{RESULTS}/{job.artefacts[0]}.json").read_text())
+            times[job.rule] = float(doc["provenance"]["run"]["module_wall_time_s"])
+        except (OSError, ValueError, KeyError, TypeError):
+            times[job.rule] = float(recorded.get(job.rule, 0.0))
+    return times
+
+
+JOB_TIMES = _job_times()
+_ORDER = sorted(JOB_TIMES, key=lambda r: -JOB_TIMES[r])
+
+
+def priority_of(rule):
+    return len(_ORDER) - _ORDER.index(rule) if JOB_TIMES.get(rule) else 0
 
 
 localrules: all, report
@@ -95,26 +152,27 @@ rule all:
         "report/report.md",
 
 
-for _exp in REGISTRY:
+for _job in REGISTRY.jobs:
+    _exp = _job.experiment
 
     rule:
-        name: _exp.name
+        name: _job.rule
         input:
-            module=str(_exp.path.relative_to(workflow.basedir)),
-            config=CONFIG_FILES,
-            numba=[ancient(NUMBA_STAMP)] if waits_for_numba(_exp) else [],
+            sources=[str(p.relative_to(workflow.basedir)) for p in _exp.sources],
+            numba=numba_input(_exp),
         output:
-            artefact_outputs(_exp.artefacts),
+            artefact_outputs(_job.artefacts),
         log:
-            f"{LOGS}/{_exp.name}.log",
+            f"{LOGS}/{_job.rule}.log",
         threads: 1
-        priority: priority_of(_exp.name)
+        priority: priority_of(_job.rule)
         params:
-            artefact=_exp.artefacts[0],
-            flags=" ".join((["--quick"] if QUICK else [])
-                           + [f"--config {shlex.quote(f)}" for f in CONFIG_FILES]),
+            rule=_job.rule,     # (the shell string is evaluated when the job runs: no _job)
+            flags=config_flags(_exp),
+            # the rerun trigger for a config change: this module's merged section alone
+            section=json.dumps(config.get(_exp.name) or {}, sort_keys=True),
         shell:
-            f"{WATCH_ENV} {THREAD_ENV} {PYTHON} -m hpfebe run {{params.artefact}} --out {RESULTS} "
+            f"{THREAD_ENV} {PYTHON} -m hpfebe run {{params.rule}} --out {RESULTS} "
             "{params.flags} 2> {log}"
 
 
@@ -126,18 +184,18 @@ rule numba_cache:
     threads: 1
     priority: 100
     shell:
-        f"{WATCH_ENV} {THREAD_ENV} {PYTHON} -m hpfebe compile --stamp {{output}} 2> {{log}}"
+        f"{THREAD_ENV} {PYTHON} -m hpfebe compile --stamp {{output}} 2> {{log}}"
 
 
 rule report:
     input:
         results=ALL_RESULTS,
         published=sorted(str(p) for p in Path("report/published").glob("*.csv")),
-        builder="src/hpfebe/report.py",
+        builder=["src/hpfebe/report.py", "src/hpfebe/results.py"],
     output:
         html="report/index.html",
         md="report/report.md",
     log:
         f"{LOGS}/report.log",
     shell:
-        f"{WATCH_ENV} {PYTHON} -m hpfebe report --results {RESULTS} --out report 2> {{log}}"
+        f"{PYTHON} -m hpfebe report --results {RESULTS} --out report 2> {{log}}"

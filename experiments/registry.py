@@ -10,6 +10,17 @@ assigns a tuple of string literals to ``ARTEFACTS`` at module level.  Other file
 (helpers shared by experiments) are ignored.  A module that calls no numba kernel says so
 with ``NUMBA = False`` (a literal; default True): the workflow runs it beside the job that
 compiles the kernels instead of after it.
+
+A module whose artefacts come from independent computations declares them as scenes, a
+literal dict ``SCENES = {"name": ("artefact", ...), ...}`` whose values partition
+``ARTEFACTS``; its ``run(config, quick=False, scenes=None)`` then computes only the
+scenes asked for.  Every scene is one workflow job (:attr:`Job.rule`: the module name for
+a module without SCENES, ``<module>__<scene>`` otherwise), so that asking for one
+artefact computes only its scene and independent scenes run on different cores.
+
+The workflow inputs of a job are its module file and the ``experiments/`` files it
+imports (``from experiments.X import ...`` / ``import experiments.X``, followed through
+those files): :attr:`Experiment.sources`.
 """
 
 from __future__ import annotations
@@ -19,7 +30,8 @@ import re
 from dataclasses import dataclass
 from pathlib import Path
 
-__all__ = ["Experiment", "Registry", "discover", "EXPERIMENTS_DIR", "RESERVED"]
+__all__ = ["Experiment", "Job", "Registry", "discover", "unknown_sections", "EXPERIMENTS_DIR", "RESERVED",
+           "SCENE_SEP"]
 
 EXPERIMENTS_DIR = Path(__file__).resolve().parent
 
@@ -27,18 +39,48 @@ EXPERIMENTS_DIR = Path(__file__).resolve().parent
 RESERVED = frozenset({"all", "report", "registry"})
 
 _ARTEFACT_RE = re.compile(r"^[a-z][a-z0-9_]*$")
+_SCENE_RE = re.compile(r"^[a-z][a-z0-9]*(_[a-z0-9]+)*$")
+
+#: between module and scene in a job's rule name: ``ch4_plasticity__example1``
+SCENE_SEP = "__"
 
 
 @dataclass(frozen=True)
 class Experiment:
-    name: str                    # module name = Snakemake rule name = config section
+    name: str                    # module name = config section
     path: Path                   # the module file
     artefacts: tuple[str, ...]   # artefact ids, first one used by `hpfebe run`
     numba: bool = True           # calls numba kernels (waits for `hpfebe compile`)
+    #: scene name -> its artefacts (``None``: the module has no SCENES, one job)
+    scenes: tuple[tuple[str, tuple[str, ...]], ...] | None = None
+    #: the module file and the experiments/ files it imports (workflow inputs)
+    sources: tuple[Path, ...] = ()
 
     @property
     def module(self) -> str:
         return f"experiments.{self.name}"
+
+    @property
+    def jobs(self) -> tuple[Job, ...]:
+        """One workflow job per scene (one job for a module without SCENES)."""
+        if self.scenes is None:
+            return (Job(self, None, self.artefacts),)
+        return tuple(Job(self, s, arts) for s, arts in self.scenes)
+
+
+@dataclass(frozen=True)
+class Job:
+    """One workflow job: a scene of an experiment module (or the whole module)."""
+
+    experiment: Experiment
+    scene: str | None            # None: the module has no SCENES
+    artefacts: tuple[str, ...]
+
+    @property
+    def rule(self) -> str:
+        """Snakemake rule name: the module name, or ``<module>__<scene>``."""
+        e = self.experiment
+        return e.name if self.scene is None else f"{e.name}{SCENE_SEP}{self.scene}"
 
 
 @dataclass(frozen=True)
@@ -49,20 +91,29 @@ class Registry:
         return iter(self.experiments)
 
     @property
+    def jobs(self) -> tuple[Job, ...]:
+        return tuple(j for e in self.experiments for j in e.jobs)
+
+    @property
     def artefacts(self) -> dict[str, Experiment]:
         """artefact id -> the experiment producing it (ordered by module, then as
         listed in ARTEFACTS)."""
         return {a: e for e in self.experiments for a in e.artefacts}
 
     def find(self, name: str) -> Experiment:
-        """The experiment producing artefact ``name`` (a module name works too)."""
-        arts = self.artefacts
-        if name in arts:
-            return arts[name]
+        """The experiment producing artefact ``name`` (a module or job name works too)."""
+        return self.find_jobs(name)[0].experiment
+
+    def find_jobs(self, name: str) -> tuple[Job, ...]:
+        """The jobs to run for ``name``: an artefact id (its scene's job), a job's rule
+        name (``<module>__<scene>``), or a module name (all its jobs)."""
+        for j in self.jobs:
+            if name in j.artefacts or name == j.rule:
+                return (j,)
         for e in self.experiments:
             if e.name == name:
-                return e
-        known = ", ".join(sorted(arts)) or "(none)"
+                return e.jobs
+        known = ", ".join(sorted(self.artefacts)) or "(none)"
         raise KeyError(f"unknown artefact {name!r}; known artefacts: {known}")
 
 
@@ -119,6 +170,91 @@ def _artefacts_of(path: Path, assigned: dict[str, ast.expr] | None = None
     return tuple(arts)
 
 
+def _scenes_of(path: Path, assigned: dict[str, ast.expr], artefacts: tuple[str, ...]
+               ) -> tuple[tuple[str, tuple[str, ...]], ...] | None:
+    """SCENES of a module file (None if it defines none), checked to partition
+    ``artefacts``."""
+    if "SCENES" not in assigned:
+        return None
+    try:
+        scenes = ast.literal_eval(assigned["SCENES"])
+    except ValueError:
+        raise ValueError(f"{path}: SCENES must be a literal dict of scene name -> tuple "
+                         "of artefact ids") from None
+    if not isinstance(scenes, dict) or not scenes:
+        raise ValueError(f"{path}: SCENES must be a non-empty dict, got {scenes!r}")
+    seen: dict[str, str] = {}
+    out = []
+    for name, arts in scenes.items():
+        if not isinstance(name, str) or not _SCENE_RE.match(name):
+            raise ValueError(f"{path}: scene name {name!r} must be lower case letters and "
+                             "digits, words joined by single underscores")
+        if isinstance(arts, str):
+            arts = (arts,)
+        if not isinstance(arts, (tuple, list)) or not arts or not all(
+                isinstance(a, str) for a in arts):
+            raise ValueError(f"{path}: SCENES[{name!r}] must be a non-empty tuple of "
+                             f"artefact ids, got {arts!r}")
+        for a in arts:
+            if a not in artefacts:
+                raise ValueError(f"{path}: SCENES[{name!r}] names {a!r}, which is not in "
+                                 "ARTEFACTS")
+            if a in seen:
+                raise ValueError(f"{path}: artefact {a!r} is in scenes {seen[a]!r} and "
+                                 f"{name!r}")
+            seen[a] = name
+        out.append((name, tuple(arts)))
+    missing = [a for a in artefacts if a not in seen]
+    if missing:
+        raise ValueError(f"{path}: artefacts {missing} are in no scene of SCENES")
+    return tuple(out)
+
+
+def _imported_experiments(path: Path, directory: Path) -> set[str]:
+    """Names of the ``experiments/`` modules that ``path`` imports (at any level)."""
+    tree = ast.parse(path.read_text(encoding="utf-8"), filename=str(path))
+    names = set()
+    for node in ast.walk(tree):
+        mods = []
+        if isinstance(node, ast.ImportFrom) and node.module:
+            if node.level == 0 and node.module.startswith("experiments."):
+                mods.append(node.module.split(".")[1])
+            elif node.level == 0 and node.module == "experiments":
+                mods += [a.name for a in node.names]
+            elif node.level == 1:
+                mods.append(node.module.split(".")[0])
+        elif isinstance(node, ast.Import):
+            mods += [a.name.split(".")[1] for a in node.names
+                     if a.name.startswith("experiments.")]
+        names.update(m for m in mods if (directory / f"{m}.py").is_file())
+    return names
+
+
+def _sources(path: Path, directory: Path) -> tuple[Path, ...]:
+    """``path`` and every experiments/ file it imports, transitively (sorted)."""
+    seen, todo = {path.stem}, [path.stem]
+    while todo:
+        for m in _imported_experiments(directory / f"{todo.pop()}.py", directory):
+            if m not in seen:
+                seen.add(m)
+                todo.append(m)
+    return (path, *sorted(directory / f"{m}.py" for m in seen - {path.stem}))
+
+
+def unknown_sections(config: dict, modules) -> list[tuple[str, str | None]]:
+    """Top-level keys of a merged config that are neither ``quick`` nor a module name,
+    each with the module name it is a likely misspelling of (or None)."""
+    import difflib
+
+    modules = sorted(modules)
+    out = []
+    for key in config:
+        if key != "quick" and key not in modules:
+            close = difflib.get_close_matches(str(key), modules, n=1, cutoff=0.8)
+            out.append((str(key), close[0] if close else None))
+    return out
+
+
 def discover(directory: Path | str | None = None) -> Registry:
     """All experiment modules in ``directory`` (default: this package), sorted by name.
     Raises ValueError if two modules claim the same artefact or a module name is
@@ -136,14 +272,17 @@ def discover(directory: Path | str | None = None) -> Registry:
         arts = _artefacts_of(path, assigned)
         if arts is None:
             continue
-        if name in RESERVED or not name.isidentifier():
+        if name in RESERVED or not name.isidentifier() or SCENE_SEP in name:
             raise ValueError(f"{path}: module name {name!r} is not allowed "
-                             f"(reserved: {sorted(RESERVED)}; must be an identifier)")
+                             f"(reserved: {sorted(RESERVED)}; must be an identifier "
+                             f"without {SCENE_SEP!r})")
         for a in arts:
             if a in owner:
                 raise ValueError(f"artefact {a!r} is claimed by both experiments/"
                                  f"{owner[a]}.py and experiments/{name}.py")
             owner[a] = name
         found.append(Experiment(name=name, path=path, artefacts=arts,
-                                numba=_numba_flag(path, assigned)))
+                                numba=_numba_flag(path, assigned),
+                                scenes=_scenes_of(path, assigned, arts),
+                                sources=_sources(path, directory)))
     return Registry(tuple(found))

@@ -176,8 +176,11 @@ def _numpy_uzawa(pr, Q, rho, bound, tol, max_iter):
 
 
 def test_compiled_uzawa_step_is_the_numpy_iteration(sticky):
-    """uzawa's compiled iteration (_uzawa_step) gives bit for bit the numpy formulation
-    of Algorithm 4.4: projected CG on b - (0, F w lambda), then the clip to [-1, 1]."""
+    """uzawa's compiled iteration (_uzawa_step) gives the numpy formulation of Algorithm
+    4.4: projected CG on b - (0, F w lambda), then the clip to [-1, 1].  To round-off,
+    not bit for bit: the numpy side's products go through BLAS, whose summation order
+    (and use of fused multiply-adds) depends on the CPU; the iteration counts may then
+    differ by one where a residual lands on the stopping threshold."""
     pr, nc = sticky, sticky.nc
     rng = np.random.default_rng(3)
     Q = 1e-4 * rng.standard_normal(2 * nc)
@@ -185,11 +188,13 @@ def test_compiled_uzawa_step_is_the_numpy_iteration(sticky):
     for bound in (None, np.abs(rng.standard_normal(nc)) * pr.F):
         _, lam, info = pr.uzawa(Q, rho=rho, tol=1e-9, max_iter=300, bound=bound)
         lam_ref, info_ref = _numpy_uzawa(pr, Q, rho, bound, 1e-9, 300)
-        assert info.iterations == info_ref.iterations and info.converged == info_ref.converged
-        assert np.array_equal(lam, lam_ref)
-        assert info.residuals == info_ref.residuals and info.steps == []
-        assert info.counts["qp_solves"] == info.iterations == len(info_ref.steps)
-        assert info.counts["cg_steps"] == sum(s.counts["cg_steps"] for s in info_ref.steps)
+        assert info.converged == info_ref.converged
+        assert abs(info.iterations - info_ref.iterations) <= 1
+        np.testing.assert_allclose(lam, lam_ref, rtol=0, atol=1e-9 * np.abs(lam_ref).max())
+        assert info.steps == [] and info.counts["qp_solves"] == info.iterations
+        n = min(len(info.residuals), len(info_ref.residuals))
+        np.testing.assert_allclose(info.residuals[:n - 1], info_ref.residuals[:n - 1],
+                                   rtol=1e-6)
     with pytest.raises(ValueError, match="lam0"):
         pr.uzawa(Q, rho=rho, lam0=np.zeros(nc + 1))
     with pytest.raises(ValueError, match="x0"):

@@ -24,6 +24,10 @@ log = logging.getLogger("hpfebe")
 
 EXIT_OK, EXIT_FAILED, EXIT_USAGE = 0, 1, 2
 
+#: loggers of dependencies kept at WARNING unless -v (scikit-fem logs every assembly at
+#: INFO: 132 of 138 lines of a job log before)
+NOISY_LOGGERS = ("numba", "skfem", "matplotlib", "PIL", "h5py", "meshio")
+
 
 class CLIError(Exception):
     """A user-facing error: printed without traceback, exit status 2."""
@@ -310,25 +314,23 @@ def check_top_level(per_file: list[tuple[Path, dict]], config: dict, modules) ->
     """The merged config's top level: ``quick`` a real bool (``"false"`` is not false),
     every section a mapping, a section name close to a module name but not one of them
     (a misspelling) an error; returns ``quick``."""
-    import difflib
+    from experiments.registry import unknown_sections
 
     quick = config.get("quick", False)
     if not isinstance(quick, bool):
         raise CLIError(f"config key 'quick' must be true or false, got {quick!r} "
                        f"({where_set(per_file, 'quick')})")
-    modules = sorted(modules)
-    for key, value in config.items():
-        if key == "quick" or key in modules:
-            if key != "quick" and value is not None and not isinstance(value, dict):
-                raise CLIError(f"config section {key!r} must be a mapping, got {value!r} "
-                               f"({where_set(per_file, key)})")
-            continue
-        close = difflib.get_close_matches(str(key), modules, n=1, cutoff=0.8)
+    for key in modules:
+        value = config.get(key)
+        if value is not None and not isinstance(value, dict):
+            raise CLIError(f"config section {key!r} must be a mapping, got {value!r} "
+                           f"({where_set(per_file, key)})")
+    for key, close in unknown_sections(config, modules):
         if close:
             raise CLIError(f"config section {key!r} is not an experiment module; did you "
-                           f"mean {close[0]!r}? ({where_set(per_file, str(key))})")
+                           f"mean {close!r}? ({where_set(per_file, key)})")
         log.warning("config section %r belongs to no experiment module (%s); ignored",
-                    key, where_set(per_file, str(key)))
+                    key, where_set(per_file, key))
     return quick
 
 
@@ -338,10 +340,10 @@ def cmd_list(args) -> int:
     registry = load_registry(root)
     published_dir = root / "report" / "published"
     rows = []
-    for exp in registry:
-        for a in exp.artefacts:
+    for job in registry.jobs:
+        for a in job.artefacts:
             pub = published_file_for(a, published_dir)
-            rows.append((a, exp.name, pub.name if pub else "-"))
+            rows.append((a, job.rule, pub.name if pub else "-"))
     claimed = set(registry.artefacts)
     if published_dir.is_dir():
         for f in sorted(published_dir.glob("*.csv")):
@@ -355,8 +357,8 @@ def cmd_list(args) -> int:
         print("no experiment modules found in", root / "experiments")
         return EXIT_OK
     w1 = max(len("artefact"), *(len(r[0]) for r in rows))
-    w2 = max(len("module"), *(len(r[1]) for r in rows))
-    print(f"{'artefact':<{w1}}  {'module':<{w2}}  published")
+    w2 = max(len("job"), *(len(r[1]) for r in rows))
+    print(f"{'artefact':<{w1}}  {'job':<{w2}}  published")
     for a, m, p in rows:
         print(f"{a:<{w1}}  {m:<{w2}}  {p}")
     return EXIT_OK
@@ -384,13 +386,26 @@ def _check_published(result, published_dir: Path) -> None:
                     result.name, shared)
 
 
+#: where ``hpfebe run --quick`` writes without ``--out``: quick results never replace the
+#: full ones in results/ (the workflow's quick run names results/ itself, with --out)
+QUICK_OUT = Path("results") / "quick"
+
+
+def _call_run(module, exp, job, section: dict, quick: bool):
+    """``module.run`` for one job: with ``scenes=(scene,)`` for a module with SCENES."""
+    if job.scene is None:
+        return module.run(section, quick=quick)
+    return module.run(section, quick=quick, scenes=(job.scene,))
+
+
 def cmd_run(args) -> int:
     root = find_root()
     registry = load_registry(root)
     try:
-        exp = registry.find(args.artefact)
+        jobs = registry.find_jobs(args.artefact)
     except KeyError as exc:
         raise CLIError(exc.args[0]) from None
+    exp = jobs[0].experiment
 
     if args.config:
         files = [Path(f) for f in args.config]
@@ -402,8 +417,14 @@ def cmd_run(args) -> int:
     config = load_config(files)
     quick = check_top_level(per_file, config, [e.name for e in registry]) or args.quick
     section = config.get(exp.name) or {}
-    out = Path(args.out) if args.out else root / "results"
-    remove_stale_temporaries(out, exp.artefacts)
+    if args.out:
+        out = Path(args.out)
+    elif quick:
+        out = root / QUICK_OUT
+        log.info("quick run: writing to %s (results/ keeps the full results; give --out "
+                 "to write elsewhere)", out)
+    else:
+        out = root / "results"
 
     import matplotlib
 
@@ -418,46 +439,50 @@ def cmd_run(args) -> int:
                        f"literal read by the registry ({exp.artefacts})")
     if not callable(getattr(module, "run", None)):
         raise CLIError(f"{exp.path} has no function run(config, quick=False)")
-
-    log.info("running %s (%s) for %s%s", exp.name, ", ".join(exp.artefacts), args.artefact,
-             " [quick]" if quick else "")
     from .params import ConfigError
 
-    t0 = time.perf_counter()
-    try:
-        with JitTimer() as jit:
-            results = module.run(section, quick=quick)
-    except ConfigError as exc:
-        raise CLIError(f"config: {exc} ({where_set(per_file, exc.path)})") from None
-    wall = time.perf_counter() - t0
-    log.info("%s finished in %.1f s (numba: %.1f s compiling, %.1f s in the JIT in all)",
-             exp.name, wall, jit.compile_s, jit.jit_s)
+    for job in jobs:
+        remove_stale_temporaries(out, job.artefacts)
+        log.info("running %s (%s) for %s%s", job.rule, ", ".join(job.artefacts),
+                 args.artefact, " [quick]" if quick else "")
+        t0 = time.perf_counter()
+        try:
+            with JitTimer() as jit:
+                results = _call_run(module, exp, job, section, quick)
+        except ConfigError as exc:
+            raise CLIError(f"config: {exc} ({where_set(per_file, exc.path)})") from None
+        wall = time.perf_counter() - t0
+        log.info("%s finished in %.1f s (numba: %.1f s compiling, %.1f s in the JIT in all)",
+                 job.rule, wall, jit.compile_s, jit.jit_s)
 
-    if not isinstance(results, (list, tuple)) or not all(
-            isinstance(r, res.ArtefactResult) for r in results):
-        raise ValueError(f"{exp.name}.run must return a list of ArtefactResult, got "
-                         f"{type(results).__name__}")
-    names = [r.name for r in results]
-    if sorted(names) != sorted(exp.artefacts):
-        raise ValueError(f"{exp.name}.run returned artefacts {names}, ARTEFACTS declares "
-                         f"{list(exp.artefacts)}")
-    published_dir = root / "report" / "published"
-    for r in results:  # validate everything before writing anything
-        res.validate(r)
-        _check_published(r, published_dir)
+        if not isinstance(results, (list, tuple)) or not all(
+                isinstance(r, res.ArtefactResult) for r in results):
+            raise ValueError(f"{exp.name}.run must return a list of ArtefactResult, got "
+                             f"{type(results).__name__}")
+        names = [r.name for r in results]
+        if sorted(names) != sorted(job.artefacts):
+            what = f"scene {job.scene!r} declares" if job.scene else "ARTEFACTS declares"
+            raise ValueError(f"{exp.name}.run returned artefacts {names}, {what} "
+                             f"{list(job.artefacts)}")
+        published_dir = root / "report" / "published"
+        for r in results:  # validate everything before writing anything
+            res.validate(r)
+            _check_published(r, published_dir)
 
-    run_info = {
-        "module": exp.name,
-        "artefacts": list(exp.artefacts),
-        "quick": quick,
-        "config_files": [str(f) for f in files],
-        "module_wall_time_s": round(wall, 3),
-        **jit.as_dict(),
-        "argv": sys.argv[1:],
-    }
-    for r in results:
-        paths = res.write_result(r, out, section, run_info=run_info)
-        log.info("wrote %s", ", ".join(str(p) for p in paths))
+        run_info = {
+            "module": exp.name,
+            "job": job.rule,
+            "scene": job.scene,
+            "artefacts": list(job.artefacts),
+            "quick": quick,
+            "config_files": [str(f) for f in files],
+            "module_wall_time_s": round(wall, 3),
+            **jit.as_dict(),
+            "argv": sys.argv[1:],
+        }
+        for r in results:
+            paths = res.write_result(r, out, section, run_info=run_info)
+            log.info("wrote %s", ", ".join(str(p) for p in paths))
     return EXIT_OK
 
 
@@ -515,14 +540,16 @@ def build_parser() -> argparse.ArgumentParser:
     sp = sub.add_parser("list", help="list every artefact, its module and published file")
     sp.set_defaults(func=cmd_list)
 
-    sp = sub.add_parser("run", help="run the experiment module producing ARTEFACT "
-                                    "(writes all artefacts of that module)")
+    sp = sub.add_parser("run", help="run the scene producing ARTEFACT (writes every "
+                                    "artefact of that scene)")
     sp.add_argument("artefact", help="artefact id, e.g. table_2_1 (see `hpfebe list`); "
-                                     "a module name works too")
+                                     "a job name (module__scene) or a module name (all its "
+                                     "scenes) works too")
     sp.add_argument("--quick", action="store_true",
                     help="CI-sized run: merge config/quick.yaml over config/config.yaml "
                          "and pass quick=True")
-    sp.add_argument("--out", metavar="DIR", help="output directory (default: results/)")
+    sp.add_argument("--out", metavar="DIR", help="output directory (default: results/, "
+                                                 "results/quick/ for a quick run)")
     sp.add_argument("--config", metavar="FILE", action="append",
                     help="config file; repeat to merge several in order (default: "
                          "config/config.yaml, plus config/quick.yaml with --quick)")
@@ -550,8 +577,9 @@ def main(argv: list[str] | None = None) -> int:
     logging.basicConfig(level=level, stream=sys.stderr,
                         format="%(asctime)s %(levelname)s %(name)s: %(message)s",
                         datefmt="%H:%M:%S")
-    if level > logging.DEBUG:  # numba's DEBUG chatter is never wanted at INFO
-        logging.getLogger("numba").setLevel(logging.WARNING)
+    if level > logging.DEBUG:  # dependencies' chatter is never wanted at INFO (job logs
+        for name in NOISY_LOGGERS:  # carry our messages; -v shows everything)
+            logging.getLogger(name).setLevel(logging.WARNING)
     os.environ.setdefault("MPLBACKEND", "Agg")
     if not getattr(args, "func", None):
         parser.print_help()

@@ -108,10 +108,10 @@ def _times_blocks(A: np.ndarray, D: np.ndarray) -> np.ndarray:
 
 @numba.njit(cache=True)
 def _times_blocks_kernel(A, D):
-    """The 1 x 3 by 3 x 3 products of :func:`_times_blocks` in the summation order of
-    np.matmul's small-matrix loop (the same numbers bit for bit, measured; the BE/BE
-    results depend on the round-off of every step), ~6x faster than the batched
-    matmul."""
+    """The 1 x 3 by 3 x 3 products of :func:`_times_blocks`, each a 3-term dot product
+    summed left to right (the order of np.matmul's small-matrix loop: the same numbers
+    bit for bit on CPUs where that loop uses no fused multiply-add, within the 3-term
+    rounding bound elsewhere), ~6x faster than the batched matmul."""
     m, n = A.shape[0], D.shape[0]
     out = np.empty((m, 3 * n))
     for r in range(m):
