@@ -43,9 +43,17 @@ Rules
 * NaN in a float column is an error unless the column is listed in
   ``meta["allow_nan_columns"]`` and explained in ``notes`` (e.g. the first rate of a
   sweep, a solver that did not converge).
-* ``claims``: the thesis's statements for this artefact, each with
-  ``holds`` = True / False / None (not decidable here) and the measured ``evidence``;
-  if a claim does not hold, the evidence says why.
+* ``claims``: checked statements, each with ``holds`` = True / False / None (not
+  decidable here, e.g. evaluated over zero converged runs: never True) and the measured
+  ``evidence``, and a ``kind`` (:data:`hpfebe.results.CLAIM_KINDS`): ``thesis`` (a
+  statement the thesis makes; the report's summary counts these), ``explanation`` (our
+  computed test of a cause for a difference: one that could have failed, and survives
+  the changes it should not depend on), ``hypothesis`` (a coincidence or reading not
+  derived), ``beyond`` (beyond the thesis).  An explanation or hypothesis names what it
+  explains in ``explains``: claim ``id``\ s of the same artefact and cells
+  (``"cells:*"``, ``"cells:<column>"``, ``"cells:<column>[key=value]"``).  An artefact
+  that differs is "explained" only when every off cell and failed thesis claim is
+  linked to an explanation that holds.
 * ``meta``: timings (``jit_s``, ``run_s``), dof, iterations, ...  ``run_s`` is shown
   as the artefact's wall time in the report.
 * Progress bars: ``for x in progress(items, desc=...)`` (quiet unless stderr is a TTY).
@@ -54,7 +62,15 @@ Rules
   Agg backend is set by the CLI; create figures with ``matplotlib.figure.Figure`` or
   ``plt.subplots`` - the CLI closes them after writing).
 
-Running: ``hpfebe run <artefact> [--quick]`` (the whole module runs and writes all its
-artefacts), or ``snakemake -j2`` for everything.  ``experiments/bem_laplace.py`` is a
+* Scenes: a module whose artefacts come from independent computations declares them,
+  ``SCENES = {"scene": ("artefact", ...), ...}``, a literal dict whose values partition
+  ``ARTEFACTS``, and takes ``run(config, quick=False, scenes=None)``: it computes only
+  the scenes asked for (``None``: all) and returns the results of their artefacts.  Each
+  scene is one workflow job (rule ``<module>__<scene>``, see
+  :mod:`experiments.registry`); artefacts that share an expensive computation belong to
+  one scene.
+
+Running: ``hpfebe run <artefact> [--quick]`` (the scene producing the artefact runs and
+writes all its artefacts), or ``snakemake -j2`` for everything.  ``experiments/bem_laplace.py`` is a
 complete small example.
 """

@@ -95,14 +95,49 @@ def test_beats_uniform_claim():
 
 
 def test_range_claim():
+    """Each extreme by its own relative difference; a published 0 against the span."""
     c = range_claim("colorbar", "u_y", (0.0, 0.59e-3), (0.0, 0.5922e-3), 0.1)
-    assert c.holds is True and "u_y" in c.evidence and "0.4 %" in c.evidence
+    assert c.holds is True and "u_y" in c.evidence and "0.4 % off" in c.evidence
+    assert "0.0 % of the published span" in c.evidence and "absolute" in c.evidence
     assert range_claim("c", "u", (-0.2, 1.0), (0.0, 1.0), 0.1).holds is False
     assert range_claim("c", "u", (-0.1, 1.0), (0.0, 1.0), 0.1).holds is True
     with pytest.raises(ValueError, match="span"):
         range_claim("c", "u", (0.0, 1.0), (1.0, 1.0), 0.1)
     with pytest.raises(ValueError, match="pairs"):
         range_claim("c", "u", (0.0,), (0.0, 1.0), 0.1)
+
+
+def test_range_claim_relative_to_each_extreme_not_the_span():
+    """Figure 4.22's work u_x case: a maximum 19 % off held at ~9 % of the span when
+    measured against the span; against the maximum itself it differs."""
+    pub, ours = (-3.0e-5, 3.3e-5), (-3.0e-5, 3.3e-5 * 0.81)
+    c = range_claim("c", "work u_x", ours, pub, 0.1)
+    assert c.holds is False
+    assert "min -3.0000e-05 against -3.0000e-05: 0.0 % off" in c.evidence
+    assert "max 2.6730e-05 against 3.3000e-05: 19.0 % off" in c.evidence
+    assert abs(ours[1] - pub[1]) / (pub[1] - pub[0]) < 0.1   # the old test passed it
+    # a small extreme far off in relative terms: the span would hide it
+    assert range_claim("c", "u", (-0.02, 1.0), (-0.01, 1.0), 0.1).holds is False
+    assert "100.0 % off" in range_claim("c", "u", (-0.02, 1.0), (-0.01, 1.0), 0.1).evidence
+    # both ends on the boundary of the tolerance hold (exact binary fractions)
+    assert range_claim("c", "u", (-1.125, 2.25), (-1.0, 2.0), 0.125).holds is True
+    assert range_claim("c", "u", (-1.125, 2.25), (-1.0, 2.0), 0.124).holds is False
+
+
+def test_range_claim_fixed_extreme_is_not_evidence():
+    """An extreme fixed by construction (a Dirichlet value) is not tested."""
+    pub = (-1.0, 1.0e-4)
+    c = range_claim("c", "u_y", (-0.5, 1.0e-4), pub, 0.1, fixed=("max",))
+    assert c.holds is False and "50.0 % off" in c.evidence
+    c = range_claim("c", "u_y", (-0.95, 7.0), pub, 0.1, fixed=("max",))
+    assert c.holds is True                # the max is not tested
+    assert "max 7.0000e+00 fixed by construction" in c.evidence
+    assert "no evidence, not tested" in c.evidence
+    assert range_claim("c", "u", (5.0, 1.0), (1.0, 1.0 + 1e-9), 0.1, fixed="min").holds
+    with pytest.raises(ValueError, match="fixed"):
+        range_claim("c", "u", (0.0, 1.0), (0.0, 1.0), 0.1, fixed=("min", "max"))
+    with pytest.raises(ValueError, match="fixed"):
+        range_claim("c", "u", (0.0, 1.0), (0.0, 1.0), 0.1, fixed=("top",))
 
 
 def test_joint_claim():

@@ -137,3 +137,26 @@ def test_published_columns_checked(tmp_path):
     missing = ArtefactResult("table_9_9", table, published="nope.csv")
     with pytest.raises(ValueError, match="not found"):
         cli._check_published(missing, tmp_path)
+
+
+def test_quick_run_without_out_keeps_full_results(tmp_path, monkeypatch):
+    """`hpfebe run X --quick` without --out writes to results/quick/ (here a scratch
+    folder), never over the full results in results/."""
+    monkeypatch.setattr(cli, "QUICK_OUT", tmp_path / "quick")
+    assert cli.main(["-q", "run", "figure_bem_laplace", "--quick"]) == 0
+    doc = json.loads((tmp_path / "quick" / "figure_bem_laplace.json").read_text())
+    assert doc["provenance"]["run"]["quick"] is True
+    assert doc["provenance"]["run"]["job"] == "bem_laplace"
+
+
+def test_run_names_a_job(tmp_path):
+    """An artefact id runs its scene's job only; the job's rule name works too."""
+    from experiments.registry import discover
+
+    reg = discover(ROOT / "experiments")
+    job = next(j for j in reg.jobs if j.scene is not None)
+    assert reg.find_jobs(job.artefacts[0]) == (job,)
+    assert reg.find_jobs(job.rule) == (job,)
+    assert reg.find_jobs(job.experiment.name) == job.experiment.jobs
+    with pytest.raises(KeyError, match="unknown artefact"):
+        reg.find_jobs("table_0_0")

@@ -360,13 +360,6 @@ def test_snakefile_refuses_a_string_quick(tmp_path):
     assert "'quick' must be true or false, got 'false'" in r.stdout + r.stderr
 
 
-def test_snakefile_jobs_watch_snakemake():
-    r = subprocess.run([sys.executable, "-m", "snakemake", "-n", "-p", "--forceall"],
-                       cwd=ROOT, capture_output=True, text=True, timeout=300)
-    assert r.returncode == 0, r.stdout + r.stderr
-    assert "HPFEBE_PARENT_PID=" in r.stdout + r.stderr
-
-
 def test_job_of_a_dead_snakemake_does_not_start(tmp_path):
     p = subprocess.Popen([sys.executable, "-c", "pass"])
     p.wait()

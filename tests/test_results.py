@@ -30,11 +30,24 @@ def test_write_result_writes_csv_and_json(tmp_path):
     assert list(df.columns) == ["h_inv", "p", "err", "rate", "dof"]
     assert math.isnan(df.rate[0]) and df.err[1] == 0.05
     doc = json.loads((tmp_path / "table_9_1.json").read_text())
-    assert doc["claims"] == [{"text": "rate ~ 1", "holds": True, "evidence": "last rate 1.0"}]
+    assert doc["claims"] == [{"text": "rate ~ 1", "holds": True, "evidence": "last rate 1.0",
+                              "kind": "thesis", "id": "", "explains": []}]
     assert doc["keys"] == ["h_inv", "p"] and doc["tolerances"] == {"err": ["factor", 2.0]}
     assert doc["published"] == "table_9_1_fake.csv" and doc["meta"]["run_s"] == 1.5
     # no temporary files left behind
     assert sorted(p.name for p in tmp_path.iterdir()) == ["table_9_1.csv", "table_9_1.json"]
+
+
+def test_claim_kinds_and_links_written(tmp_path):
+    claims = [Claim("rate ~ 1", False, "rate 0.5", id="rate"),
+              Claim("pre-asymptotic", True, "rate 0.99 on finer meshes", kind="explanation",
+                    id="pre", explains=("rate", "cells:err[h_inv=3]")),
+              Claim("ours faster", True, "x2", kind="beyond")]
+    write_result(_result(claims=claims), tmp_path)
+    doc = json.loads((tmp_path / "table_9_1.json").read_text())
+    assert [c["kind"] for c in doc["claims"]] == ["thesis", "explanation", "beyond"]
+    assert doc["claims"][1]["explains"] == ["rate", "cells:err[h_inv=3]"]
+    assert doc["claims"][1]["id"] == "pre" and doc["claims"][2]["id"] == ""
 
 
 def test_provenance_fields(tmp_path):
@@ -85,6 +98,13 @@ def test_nan_in_object_column_rejected(tmp_path):
     (dict(tolerances={"err": ("factor", 0.5)}), "tolerance value"),
     (dict(name="bad name"), "plain artefact id"),
     (dict(claims=[Claim("x", "yes", "")]), "Claim.holds"),
+    (dict(claims=[Claim("x", True, kind="analysis")]), "Claim.kind"),
+    (dict(claims=[Claim("x", True, explains=("cells:err",))]), "only explanation"),
+    (dict(claims=[Claim("x", True, kind="explanation", explains=("nope",))]),
+     "neither a claim id"),
+    (dict(claims=[Claim("x", True, kind="hypothesis", explains="cells:err")]),
+     "tuple of claim ids"),
+    (dict(claims=[Claim("x", False, id="a"), Claim("y", True, id="a")]), "unique"),
 ])
 def test_contract_violations(tmp_path, kw, match):
     with pytest.raises(ValueError, match=match):

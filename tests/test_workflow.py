@@ -134,6 +134,9 @@ def test_one_artefact_runs_its_job_only(built):
     log = (tree / "results" / "logs" / "bem_laplace.log").read_text()
     assert "skfem" not in log            # dependencies' INFO lines kept out of job logs
     assert "bem_laplace finished" in log
+    # the job watches the Snakemake that started it (the pid reaches it through the
+    # environment, not through its command: see test_job_commands_do_not_change...)
+    assert "stops when process" in log and "the Snakemake that started it" in log
 
 
 def test_second_call_does_nothing(built):
@@ -207,3 +210,30 @@ def test_registry_rules(tmp_path):
     (tmp_path / "report.py").write_text('ARTEFACTS = ("table_2_9",)\n')
     with pytest.raises(ValueError, match="reserved"):
         registry.discover(tmp_path)
+
+
+def test_registry_scenes(tmp_path):
+    """SCENES partition ARTEFACTS; each scene is a job `<module>__<scene>`; a module's
+    sources are its file and the experiments/ files it imports."""
+    registry = _registry_module()
+    (tmp_path / "_shared.py").write_text("X = 1\n")
+    (tmp_path / "ch1_a.py").write_text(
+        'from experiments._shared import X\nARTEFACTS = ("table_1_1", "figure_1_1", '
+        '"figure_1_2")\nSCENES = {"one": ("table_1_1", "figure_1_1"), "two": '
+        '("figure_1_2",)}\n')
+    (tmp_path / "ch1_b.py").write_text('ARTEFACTS = ("table_1_2",)\n')
+    reg = registry.discover(tmp_path)
+    assert [j.rule for j in reg.jobs] == ["ch1_a__one", "ch1_a__two", "ch1_b"]
+    assert reg.find_jobs("figure_1_2")[0].artefacts == ("figure_1_2",)
+    assert [p.name for p in reg.find("ch1_a").sources] == ["ch1_a.py", "_shared.py"]
+    bad = {'{"one": ("table_1_1",), "two": ("figure_1_2",)}': "in no scene",
+           '{"one": ("table_1_1", "figure_1_1"), "two": ("figure_1_1", "figure_1_2")}':
+               "in scenes",
+           '{"one": ("table_1_1", "figure_1_1", "figure_1_2", "table_9_9")}': "not in ARTEFACTS",
+           '{"One": ("table_1_1", "figure_1_1", "figure_1_2")}': "scene name",
+           'dict(one=("table_1_1",))': "literal dict"}
+    for scenes, msg in bad.items():
+        (tmp_path / "ch1_a.py").write_text(
+            f'ARTEFACTS = ("table_1_1", "figure_1_1", "figure_1_2")\nSCENES = {scenes}\n')
+        with pytest.raises(ValueError, match=msg):
+            registry.discover(tmp_path)

@@ -191,6 +191,7 @@ def _watch_parent_from_env() -> None:
         return
     if pid > 1 and pid != os.getpid():
         watch_parent(pid)
+        log.info("this run stops when process %d (the Snakemake that started it) ends", pid)
 
 
 def remove_stale_temporaries(out: Path, artefacts) -> list[Path]:
@@ -391,6 +392,15 @@ def _check_published(result, published_dir: Path) -> None:
 QUICK_OUT = Path("results") / "quick"
 
 
+def _peak_rss_mb() -> float | None:
+    """The process's peak resident memory so far, MB (Linux: ru_maxrss in kB)."""
+    try:
+        import resource
+    except ImportError:            # pragma: no cover - not on Windows
+        return None
+    return round(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024, 1)
+
+
 def _call_run(module, exp, job, section: dict, quick: bool):
     """``module.run`` for one job: with ``scenes=(scene,)`` for a module with SCENES."""
     if job.scene is None:
@@ -477,6 +487,7 @@ def cmd_run(args) -> int:
             "quick": quick,
             "config_files": [str(f) for f in files],
             "module_wall_time_s": round(wall, 3),
+            "peak_rss_mb": _peak_rss_mb(),
             **jit.as_dict(),
             "argv": sys.argv[1:],
         }

@@ -19,7 +19,8 @@ it, so that a truncated, replaced or emptied file is found "damaged" and never u
 Claims that recur are built by helpers, so that the verdict and its evidence read the
 same everywhere: :func:`rate_claim` (an observed rate against the expected one),
 :func:`beats_uniform_claim` (adaptive against uniform refinement at equal DOF) and
-:func:`range_claim` (a computed range against a published one, e.g. a colorbar), and
+:func:`range_claim` (a computed range against a published one, e.g. a colorbar: each
+extreme by its relative difference), and
 :func:`joint_claim` (one statement made of several checked parts).
 
 This is an edge module: no numerics (the log-log interpolation is
@@ -49,6 +50,8 @@ import pandas as pd
 
 __all__ = [
     "Claim",
+    "CLAIM_KINDS",
+    "CELLS_PREFIX",
     "rate_claim",
     "beats_uniform_claim",
     "range_claim",
@@ -74,18 +77,42 @@ PROVENANCE_PACKAGES = ("numpy", "scipy", "numba", "scikit-fem", "pandas", "matpl
                        "hpfebe")
 
 
+#: what a claim is (the report counts ``thesis`` claims in its summary, the others apart):
+#: ``thesis`` - a statement the thesis makes, checked against what was measured;
+#: ``explanation`` - our computed test of a cause for a difference (it could have
+#: failed, and it survives the changes it should not depend on), linked by ``explains``
+#: to the claims or cells it explains; ``hypothesis`` - a numerical coincidence or a
+#: reading not derived, linked the same way; ``beyond`` - a result beyond the thesis.
+CLAIM_KINDS = ("thesis", "explanation", "hypothesis", "beyond")
+
+#: an ``explains`` entry naming table cells instead of a claim id: ``"cells:*"`` (every
+#: off cell of the artefact's table), ``"cells:<column>"`` (every off cell of that
+#: column) or ``"cells:<column>[key=value,...]"`` (the off cells of the rows whose key
+#: columns have those values, compared as numbers where they parse as numbers)
+CELLS_PREFIX = "cells:"
+
+
 @dataclass
 class Claim:
-    """A statement of the thesis, checked against what was measured.
+    """A checked statement about an artefact.
 
-    text : the thesis's claim, e.g. "BE energy rate of the h-version ~0.66 (theory 2/3)"
-    holds : True (holds), False (differs), None (not decidable here)
-    evidence : the measured numbers that decide it, and why it differs if it does
+    text : the statement, e.g. "BE energy rate of the h-version ~0.66 (theory 2/3)"
+    holds : True (holds), False (differs), None (not decidable here, e.g. evaluated
+        over zero converged runs)
+    evidence : the measured numbers that decide it
+    kind : one of :data:`CLAIM_KINDS` (default ``"thesis"``)
+    id : a short name, unique within the artefact, that ``explains`` entries refer to
+    explains : for ``explanation`` and ``hypothesis`` claims: the ids of the claims of
+        the same artefact, and the cells (:data:`CELLS_PREFIX`), whose difference this
+        claim accounts for
     """
 
     text: str
     holds: bool | None
     evidence: str = ""
+    kind: str = "thesis"
+    id: str = ""
+    explains: tuple[str, ...] = ()
 
 
 def _finite(name: str, v) -> float:
@@ -139,9 +166,22 @@ def beats_uniform_claim(statement: str, dof_adaptive, err_adaptive, dof_uniform,
                  f"{e / e_u:.3f} (holds if {cond})")
 
 
-def range_claim(statement: str, name: str, ours, published, rel_tol: float) -> Claim:
-    """A computed range ``ours = (lo, hi)`` against a published one: holds iff both ends
-    deviate by at most ``rel_tol`` x |published span|."""
+#: the extremes of a range, as :func:`range_claim` names them
+RANGE_EXTREMES = ("min", "max")
+
+
+def range_claim(statement: str, name: str, ours, published, rel_tol: float,
+                fixed: Iterable[str] = ()) -> Claim:
+    """A computed range ``ours = (lo, hi)`` against a published one (e.g. a colour
+    bar): holds iff each extreme is within ``rel_tol`` of the published one, relative
+    to it: |lo - plo| / |plo| and |hi - phi| / |phi| (the relative difference of each
+    max/min, not a share of the span).  A published extreme 0 has no relative
+    difference: there the absolute difference, as a share of the published span,
+    counts (and the evidence says so).
+
+    ``fixed`` names the extremes (``"min"``, ``"max"``) that are fixed by construction,
+    e.g. a Dirichlet value: they are no evidence, so they are not tested (the evidence
+    says so and still shows them)."""
     rel_tol = _finite("rel_tol", rel_tol)
     if rel_tol < 0:
         raise ValueError(f"rel_tol must be >= 0, got {rel_tol!r}")
@@ -153,11 +193,28 @@ def range_claim(statement: str, name: str, ours, published, rel_tol: float) -> C
     span = abs(phi - plo)
     if span == 0:
         raise ValueError(f"published range must have a non-zero span, got {published!r}")
-    dev = max(abs(lo - plo), abs(hi - phi)) / span
-    return Claim(statement, bool(dev <= rel_tol),
-                 f"{name} {lo:.4e}..{hi:.4e} (published {plo:.4e}..{phi:.4e}): largest "
-                 f"deviation {100 * dev:.1f} % of the published span (tolerance "
-                 f"{100 * rel_tol:g} %)")
+    fixed = tuple(fixed) if not isinstance(fixed, str) else (fixed,)
+    bad = [f for f in fixed if f not in RANGE_EXTREMES]
+    if bad or len(set(fixed)) == len(RANGE_EXTREMES):
+        raise ValueError(f"fixed must name at most one of {RANGE_EXTREMES} (an extreme "
+                         f"fixed by construction), got {fixed!r}")
+    parts, devs = [], []
+    for which, v, pv in (("min", lo, plo), ("max", hi, phi)):
+        if which in fixed:
+            parts.append(f"{which} {v:.4e} fixed by construction (published {pv:.4e}): "
+                         "no evidence, not tested")
+            continue
+        if pv != 0:
+            dev = abs(v - pv) / abs(pv)
+            parts.append(f"{which} {v:.4e} against {pv:.4e}: {100 * dev:.1f} % off")
+        else:
+            dev = abs(v) / span
+            parts.append(f"{which} {v:.4e} against 0: |{which}| = {100 * dev:.1f} % of "
+                         "the published span (absolute: no relative difference to 0)")
+        devs.append(dev)
+    return Claim(statement, bool(max(devs) <= rel_tol),
+                 f"{name} {lo:.4e}..{hi:.4e} (published {plo:.4e}..{phi:.4e}): "
+                 + "; ".join(parts) + f" (tolerance {100 * rel_tol:g} % of each extreme)")
 
 
 def joint_claim(statement: str, *parts: Claim, note: str = "") -> Claim:
@@ -397,6 +454,26 @@ def validate(result: ArtefactResult) -> None:
         if c.holds not in (True, False, None):
             raise ValueError(f"{name}: Claim.holds must be True, False or None, got "
                              f"{c.holds!r} for {c.text!r}")
+        if c.kind not in CLAIM_KINDS:
+            raise ValueError(f"{name}: Claim.kind must be one of {CLAIM_KINDS}, got "
+                             f"{c.kind!r} for {c.text!r}")
+        if not isinstance(c.explains, (tuple, list)) or not all(
+                isinstance(x, str) and x for x in c.explains):
+            raise ValueError(f"{name}: Claim.explains must be a tuple of claim ids or "
+                             f"'cells:...' names, got {c.explains!r} for {c.text!r}")
+        if c.explains and c.kind not in ("explanation", "hypothesis"):
+            raise ValueError(f"{name}: only explanation and hypothesis claims explain "
+                             f"something; {c.kind} claim {c.text!r} has explains="
+                             f"{tuple(c.explains)!r}")
+    ids = [c.id for c in result.claims if c.id]
+    if len(set(ids)) != len(ids):
+        raise ValueError(f"{name}: claim ids must be unique, got {ids}")
+    for c in result.claims:
+        for x in c.explains:
+            if not x.startswith(CELLS_PREFIX) and x not in ids:
+                raise ValueError(f"{name}: claim {c.text!r} explains {x!r}, which is "
+                                 f"neither a claim id of this artefact ({ids}) nor a "
+                                 f"'{CELLS_PREFIX}...' name")
     allowed = set(result.meta.get("allow_nan_columns", ()))
     unknown = allowed - set(cols)
     if unknown:
@@ -465,7 +542,8 @@ def write_result(result: ArtefactResult, out_dir: Path | str, config: dict | Non
         "published": result.published,
         "keys": list(result.keys),
         "tolerances": {k: [v[0], v[1]] for k, v in result.tolerances.items()},
-        "claims": [{"text": c.text, "holds": c.holds, "evidence": c.evidence}
+        "claims": [{"text": c.text, "holds": c.holds, "evidence": c.evidence,
+                    "kind": c.kind, "id": c.id, "explains": list(c.explains)}
                    for c in result.claims],
         "notes": result.notes,
         "meta": result.meta,
