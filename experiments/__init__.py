@@ -50,7 +50,7 @@ Rules
   computed test of a cause for a difference: one that could have failed, and survives
   the changes it should not depend on), ``hypothesis`` (a coincidence or reading not
   derived), ``beyond`` (beyond the thesis).  An explanation or hypothesis names what it
-  explains in ``explains``: claim ``id``\ s of the same artefact and cells
+  explains in ``explains``: the ``id`` of claims of the same artefact and cells
   (``"cells:*"``, ``"cells:<column>"``, ``"cells:<column>[key=value]"``).  An artefact
   that differs is "explained" only when every off cell and failed thesis claim is
   linked to an explanation that holds.

@@ -15,3 +15,12 @@ if not any(v in os.environ for v in _VARS):
     for _var in _VARS:
         os.environ[_var] = "1"
     threadpool_limits(limits=1, user_api="blas")
+
+# The experiments package lives in the repository root, not in the installed package:
+# tests that import it find it as `hpfebe run` does (cli.find_root), in any order.
+import sys  # noqa: E402
+from pathlib import Path  # noqa: E402
+
+_ROOT = str(Path(__file__).resolve().parents[1])
+if _ROOT not in sys.path:
+    sys.path.insert(0, _ROOT)
