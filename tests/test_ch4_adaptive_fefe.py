@@ -143,6 +143,19 @@ def test_quick_run_produces_all_artefacts(quick_run):
     assert np.all(np.isfinite(meshio.read(out / vtus[0]).point_data["displacement"]))
 
 
+def test_claim_kinds_and_links(quick_run):
+    """The thesis's statements are thesis claims; the wider reading of 'near' is a
+    hypothesis linked to 'most'; Newton convergence and the u_y range are ours."""
+    res, _ = quick_run
+    kinds = {n: {c["id"]: (c["kind"], c["explains"]) for c in js["claims"]}
+             for n, (js, _) in res.items()}
+    assert kinds["figure_4_13"] == {"concentrates": ("thesis", []), "most": ("thesis", []),
+                                    "wider": ("hypothesis", ["most"])}
+    for n in ("figure_4_14", "figure_4_15"):
+        assert kinds[n] == {"beats": ("thesis", []), "newton": ("beyond", [])}
+    assert kinds["figure_4_16"] == {"uy_range": ("beyond", [])}
+
+
 def test_adaptive_indicator_below_uniform_at_comparable_dof(quick_run):
     res, _ = quick_run
     for name, body in (("figure_4_14", "slave"), ("figure_4_15", "master")):

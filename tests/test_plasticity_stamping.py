@@ -97,18 +97,31 @@ def test_bad_input():
         curve_difference([1.0], [1.0, 2.0])
 
 
+def _run(artefact: str, out: Path):
+    r = subprocess.run([sys.executable, "-m", "hpfebe", "run", artefact, "--quick",
+                        "--out", str(out)], cwd=ROOT, capture_output=True, text=True,
+                       timeout=600)
+    assert r.returncode == 0, r.stderr[-3000:]
+
+
+def _claims(out: Path, name: str) -> dict:
+    return {c["id"]: c for c in json.loads((out / f"{name}.json").read_text())["claims"]}
+
+
 def test_experiment_quick(tmp_path):
-    """figure_4_1 ... figure_4_12 through the command line (quick configuration)."""
-    out = subprocess.run([sys.executable, "-m", "hpfebe", "run", "figure_4_5", "--quick",
-                          "--out", str(tmp_path)], cwd=ROOT, capture_output=True, text=True,
-                         timeout=600)
-    assert out.returncode == 0, out.stderr[-3000:]
+    """figure_4_1 ... figure_4_12 through the command line (quick configuration), one
+    scene per example: asking for an artefact of one computes only its example."""
+    _run("figure_4_5", tmp_path)
+    assert {p.stem for p in tmp_path.glob("figure_4_*.json")} == {
+        f"figure_4_{i}" for i in range(1, 6)}                    # Example 1 only
+    _run("figure_4_12", tmp_path)
     for i in range(1, 13):
         assert (tmp_path / f"figure_4_{i}.png").exists()
         d = json.loads((tmp_path / f"figure_4_{i}.json").read_text())
         assert d["claims"]
     d5 = json.loads((tmp_path / "figure_4_5.json").read_text())
     assert d5["meta"]["all_converged"] and d5["claims"][0]["holds"] is True
+    assert "bebe_s" not in d5["meta"]                              # no BE/BE in Example 1
     d10 = json.loads((tmp_path / "figure_4_10.json").read_text())
     assert d10["meta"]["all_converged"] and d10["meta"]["bebe_s"] > 0   # BE/BE computed
     assert set(d10["meta"]["bebe_s_per_theta"]) == {"1", "0"}           # both hardenings
@@ -116,9 +129,19 @@ def test_experiment_quick(tmp_path):
     for i in (10, 11, 12):
         d = json.loads((tmp_path / f"figure_4_{i}.json").read_text())
         assert all(c["holds"] is not None for c in d["claims"][:2])     # decided
+    # claim kinds: the thesis's statements; the convergence at X is a hypothesis (two
+    # shrinking differences are no rate), locking and the BE/BE mesh study are ours
+    for i in range(1, 12):
+        assert all(c["kind"] == "thesis" for c in _claims(tmp_path, f"figure_4_{i}")
+                   .values())
+    c12 = _claims(tmp_path, "figure_4_12")
+    assert {k: c["kind"] for k, c in c12.items()} == {
+        "close": "thesis", "bebe": "thesis", "converges": "hypothesis",
+        "locking": "beyond", "bebe_study": "beyond"}
     # BE/BE mesh study (bebe_h_levels, three meshes, thetas[0]): present and decided
     d12 = json.loads((tmp_path / "figure_4_12.json").read_text())
     assert len(d12["meta"]["bebe_study_s_per_h"]) == 3
-    study = [c for c in d12["claims"] if "BE/BE converges under mesh refinement" in c["text"]]
-    assert len(study) == 1 and study[0]["holds"] is not None
-    assert "BE/BE vs FE/FE on the same mesh" in study[0]["evidence"]
+    study = c12["bebe_study"]
+    assert "BE/BE converges under mesh refinement" in study["text"]
+    assert study["holds"] is not None
+    assert "BE/BE vs FE/FE on the same mesh" in study["evidence"]
