@@ -77,8 +77,11 @@ def compare(table: pd.DataFrame, published: pd.DataFrame, col: str) -> pd.Series
     return m[col] / m[f"{col}_pub"]
 
 
-def add_slope(ax, x, y0, slope, label, **kw):
-    """Reference line y = y0 (x / x[0])^slope over the range of x."""
+def add_slope(ax, x, y0, slope, label, below=False, **kw):
+    """Reference line y = y0 (x / x[0])^slope over the range of x, labelled above (or
+    ``below``) its right end, right-aligned so that the label stays inside the axes."""
     x = np.asarray([np.min(x), np.max(x)], float)
     ax.loglog(x, y0 * (x / x[0]) ** slope, "k--", lw=0.8, alpha=0.7, **kw)
-    ax.annotate(label, (x[-1], y0 * (x[-1] / x[0]) ** slope), fontsize=7, alpha=0.8)
+    ax.annotate(label, (x[-1], y0 * (x[-1] / x[0]) ** slope), xytext=(0, -3 if below else 3),
+                textcoords="offset points", ha="right", va="top" if below else "bottom",
+                fontsize=7, alpha=0.8)

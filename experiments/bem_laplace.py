@@ -147,12 +147,12 @@ def run(config: dict, quick: bool = False) -> list[ArtefactResult]:
     t_run = time.perf_counter()
     table = pd.concat([_sweep(p, ns, x0, extra) for p in degrees], ignore_index=True)
     run_s = time.perf_counter() - t_run
-    claim = joint_claim(
+    claim = replace(joint_claim(
         "L2 error of the Neumann data converges like h^p",
         *(rate_claim("", table[table.p == p].l2_rate.iloc[-1], p, RATE_TOLERANCE,
                      f"rate for p={p}") for p in degrees),
         note="the last rate of each degree; a miss means pre-asymptotic meshes or an error "
-             "in the operators")
+             "in the operators"), kind="beyond")   # not an artefact of the thesis
     return [ArtefactResult(name="figure_bem_laplace", table=table,
                            figure=_figure(table, degrees, ns), keys=("p", "n_per_side"),
                            claims=[claim], notes=_notes(x0, extra),

@@ -128,15 +128,16 @@ def _claims(table: pd.DataFrame, main: pd.DataFrame, statement: str) -> list[Cla
     return [
         Claim("beyond the thesis: with alpha = 0 the threshold grows with p (like p^2)",
               bool(np.all(np.diff(g0.lambda_star) > 0)),
-              "lambda*(p) = " + ", ".join(f"{v:.2f}" for v in g0.lambda_star)),
+              "lambda*(p) = " + ", ".join(f"{v:.2f}" for v in g0.lambda_star),
+              kind="beyond"),
         Claim("the computed threshold respects the sufficient condition of Lemma 2.2.3",
               bool(np.all(main.lambda_star <= main.lemma_bound)),
               "lambda* / bound = " + ", ".join(
-                  f"{v:.2f}" for v in (main.lambda_star / main.lemma_bound))),
+                  f"{v:.2f}" for v in (main.lambda_star / main.lemma_bound)), id="lemma"),
         Claim("thesis (Example 3): the coercivity threshold lies between lambda = 1 and 5 for "
               "p = 1 and between 5 and 10 for p = 3",
               bool(1 < s1.min() and s1.max() < 5 and 5 < s3.min() and s3.max() < 10),
-              statement),
+              statement, id="example3"),
     ]
 
 

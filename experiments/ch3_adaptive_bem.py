@@ -36,13 +36,14 @@ from __future__ import annotations
 import logging
 import math
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 import pandas as pd
 from matplotlib.collections import LineCollection
 from matplotlib.figure import Figure
-from matplotlib.ticker import NullFormatter
+from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter
+from mpl_toolkits.axes_grid1 import make_axes_locatable
 
 from hpfebe import BoundaryMesh
 from hpfebe.adaptivity import adapt
@@ -389,17 +390,24 @@ def fig_mesh_sequence(recs, mag, title):
 
 
 def fig_interior(X, Y, u, mag, title):
-    fig = Figure(figsize=(10.0, 4.3))
-    axs = fig.subplots(1, 2)
+    fig = Figure(figsize=(10.0, 4.6))
+    axs = fig.subplots(1, 2, gridspec_kw=dict(wspace=0.3))
+    Xd, Yd = X + mag * u[..., 0], Y + mag * u[..., 1]
     for ax, c, name in zip(axs, (0, 1), ("x-component", "y-component")):
-        Xd, Yd = X + mag * u[..., 0], Y + mag * u[..., 1]
         m = ax.pcolormesh(Xd, Yd, u[..., c], shading="gouraud", cmap="jet")
         step = max(1, (X.shape[0] - 1) // 20)
         for i in range(0, X.shape[0], step):
             ax.plot(Xd[i, :], Yd[i, :], "k-", lw=0.3)
             ax.plot(Xd[:, i], Yd[:, i], "k-", lw=0.3)
-        fig.colorbar(m, ax=ax, format="%.4e")
+        # a colour bar as high as the (equal-aspect) axes, its ticks 1.2 with "1e-4" on
+        # top: short labels that stay clear of the next panel (exact extremes: title)
+        cax = make_axes_locatable(ax).append_axes("right", size="4%", pad=0.08)
+        cb = fig.colorbar(m, cax=cax)
+        cb.formatter.set_powerlimits((0, 0))
+        cb.update_ticks()
         ax.set_aspect("equal")
+        ax.set_xlim(Xd.min(), Xd.max())
+        ax.set_ylim(Yd.min(), Yd.max())
         ax.set_title(f"{name}: {u[..., c].min():.4e} .. {u[..., c].max():.4e}",
                      fontsize="small")
     fig.suptitle(title + f" (grid deformed x{mag:g})", fontsize="small")
@@ -409,7 +417,7 @@ def fig_interior(X, Y, u, mag, title):
 def fig_error(errtab, title):
     """Left: the thesis's err(U) = | |||U|||_B - |||U_190|||_B | (solid) and against the
     finer reference (dashed); right: the error |||U_ref - U|||_B (W and V parts)."""
-    fig = Figure(figsize=(11.0, 4.5))
+    fig = Figure(figsize=(11.0, 4.5), layout="constrained")
     axs = fig.subplots(1, 2)
     marks = {"uniform": "s", "adaptive (3.107)": "o", "adaptive (3.107) balanced": "^"}
     for kind, df in errtab.groupby("refinement", sort=False):
@@ -423,12 +431,22 @@ def fig_error(errtab, title):
     axs[1].set_ylabel(r"|||U$_{ref}$ - U|||$_B$ (W and V parts)")
     for ax in axs:
         ax.set_xlabel("DOF")
-        ax.xaxis.set_minor_formatter(NullFormatter())
-        ax.yaxis.set_minor_formatter(NullFormatter())
+        _readable_log_axis(ax.xaxis)
+        _readable_log_axis(ax.yaxis)
         ax.grid(True, which="both", alpha=0.3)
-        ax.legend(fontsize="x-small")
+        # below the axes: err(U) crosses zero, its curves reach every corner of the panel
+        ax.legend(fontsize="x-small", loc="upper center", bbox_to_anchor=(0.5, -0.13),
+                  ncol=2)
     fig.suptitle(title, fontsize="small")
     return fig
+
+
+def _readable_log_axis(axis):
+    """Labelled major ticks at 1, 2, 5 x 10^k (20, 50, 100; 0.002, 0.005, 0.01), so that a
+    log axis spanning a decade or two reads."""
+    axis.set_major_locator(LogLocator(subs=(1.0, 2.0, 5.0), numticks=30))
+    axis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
+    axis.set_minor_formatter(NullFormatter())
 
 
 # ----------------------------------------------------------------------------- tables
@@ -579,9 +597,18 @@ def _interior_fields(s: _Setup, ex1, ex1_alt, recs2):
 
 
 # ----------------------------------------------------------------------------- claims
-def _claim_adaptive(errtab, label, dof_ref, last_step, beyond=False):
+def _variant(claim: Claim, variant: str, cid: str = "") -> Claim:
+    """A claim about indicator ``variant``: the thesis's for (3.107) as written
+    ("literal", id ``cid``), beyond the thesis for our balanced variant."""
+    if variant == "literal":
+        return replace(claim, id=cid)
+    return replace(claim, kind="beyond")
+
+
+def _claim_adaptive(errtab, variant, dof_ref, last_step, beyond=False):
     """Adaptive better than uniform at the same DOF: decided on |||U_ref - U|||_B (below
     BETTER x uniform); the thesis's err(U) columns are quoted."""
+    label = VARIANT_LABEL[variant]
     ad = errtab[(errtab.refinement == label) & (errtab.step <= last_step)]
     un = errtab[errtab.refinement == "uniform"]
     dof_last = float(ad.dof.iloc[-1])
@@ -609,13 +636,55 @@ def _claim_adaptive(errtab, label, dof_ref, last_step, beyond=False):
                       + ". The thesis's err(U) is a difference of norms, which crosses zero "
                         "(|||U|||_B is not monotone under adaptive refinement) and decides "
                         "nothing by itself; a tie is not 'better'.")
-    return claim
+    return replace(claim, kind="beyond") if beyond else \
+        _variant(claim, variant, "adaptive_literal")
+
+
+def _ratio_to_uniform(errtab, variant, last_step) -> float:
+    """|||U_ref - U|||_B of ``variant`` after ``last_step`` steps over the uniform one
+    log-log interpolated at the same DOF (NaN outside the uniform DOF range)."""
+    ad = errtab[(errtab.refinement == VARIANT_LABEL[variant]) & (errtab.step <= last_step)]
+    un = errtab[(errtab.refinement == "uniform") & (errtab.err_true > 0)]
+    dof = float(ad.dof.iloc[-1])
+    if not un.dof.min() <= dof <= un.dof.max():
+        return math.nan
+    return float(ad.err_true.iloc[-1]) / loglog_interpolate(dof, un.dof, un.err_true)
+
+
+def _units_explanation(s: _Setup, ext, errtab, adaptive: list[Claim]) -> Claim | None:
+    """Explanation of a failed "adaptive better" claim of the literal (3.107): its
+    consistency term (a strain) is negligible beside the traction term, so the indicator
+    never targets the traction error; the same algorithm with the term in traction units
+    (balanced) beats uniform refinement, after n_steps and after the longer run."""
+    lit = [c for c in adaptive if c.id == "adaptive_literal"]
+    if not {"literal", "balanced"} <= set(s.variants) or not lit or lit[0].holds is not False:
+        return None
+    # eta^2 = traction^2 + w^2 consistency^2, both variants on the same step-0 solution
+    e_l, e_b = (np.asarray(ext[v][0]["eta"], float) for v in ("literal", "balanced"))
+    cons2 = (e_b ** 2 - e_l ** 2).sum() / (s.w["balanced"] ** 2 - 1.0)
+    ratio = math.sqrt(cons2 / max((e_l ** 2).sum() - cons2, 1e-300))
+    steps = sorted({s.prm.n_steps, max(s.prm.n_steps, s.prm.n_steps_extended)})
+    r = {(v, k): _ratio_to_uniform(errtab, v, k) for v in ("literal", "balanced")
+         for k in steps}
+    return Claim(
+        text="the literal (3.107) does not beat uniform refinement because its consistency "
+             "term (a strain, beside a traction) is negligible: with that term in traction "
+             "units (x E') the same algorithm does, after every number of steps run",
+        holds=bool(ratio < 1e-3 and all(r[("balanced", k)] < BETTER for k in steps)),
+        evidence=f"step 0: ||consistency term|| / ||traction term|| = {ratio:.1e} in the "
+                 f"literal indicator (E' = {s.w['balanced']:.6g}); |||U_ref - U|||_B "
+                 "adaptive / uniform at the same DOF: " + "; ".join(
+                     f"after {k} steps literal {r[('literal', k)]:.3f}, balanced "
+                     f"{r[('balanced', k)]:.3f}" for k in steps)
+                 + f" ('better': below {BETTER})",
+        kind="explanation", id="units", explains=("adaptive_literal",))
 
 
 def _newton_claim(all_recs, ref):
     ok = all(r["state"]["res"].converged for r in all_recs) and bool(ref["res"].converged)
     it_all = [r["state"]["newton"] for r in all_recs]
     return Claim(
+        kind="beyond",
         text="(solver) Newton's method converges at every refinement step",
         holds=bool(ok),
         evidence=f"{len(all_recs)} adaptive solves (both examples, both indicator "
@@ -637,7 +706,7 @@ def _refinement_claims(s: _Setup, ex1):
         frac = tot["zone_or_corner"] / max(tot["n"], 1)
         first_zone = next((r["step"] for r in recs[:-1]
                            if refined_near(r["mesh"], r["marked"], 1)["zone"] > 0), None)
-        claims.append(Claim(
+        claims.append(_variant(Claim(
             text="Example 1: most refinement happens in the zone of actual contact and "
                  f"near the corners of Omega (where the boundary conditions change) "
                  f"[{VARIANT_LABEL[v]}]",
@@ -647,13 +716,13 @@ def _refinement_claims(s: _Setup, ex1):
                      f"{tot['zone']} on the contact zone (bottom side), {tot['corner']} "
                      f"within 0.25 of a corner, {tot['zone_or_corner']} in either "
                      f"({100 * frac:.0f} %); first refinement on the contact zone at step "
-                     f"{first_zone}."))
+                     f"{first_zone}."), v, "zone_literal"))
     sym = all(_symmetric_marking(ex1[(s.d_main, v)]) for v in s.variants)
     claims.append(Claim(
         text="Example 1: elements at symmetric positions are refined in each step",
         holds=bool(sym), evidence="refined sets compared with their mirror images "
                                   "x -> -x at every step, both indicator variants: "
-                                  + ("identical" if sym else "differ")))
+                                  + ("identical" if sym else "differ"), id="symmetric"))
     return claims
 
 
@@ -675,32 +744,80 @@ def _colorbar_claims(s: _Setup, ranges):
         if any(abs(d - 0.6e-4) < 1e-12 for d in dev) else None,
         evidence="; ".join(f"d = {d:g}: u_x {_rng(d, 'ux_range')}, u_y {_rng(d, 'uy_range')}"
                            f" (max deviation {100 * dev[d]:.1f} % of the published span)"
-                           for d in prm.example1_d)
-        + f". d = {best_d:g} matches the colorbars (the problem is positively homogeneous "
-          "in d: d = 0.6e-4 gives exactly one tenth of every displacement), so Fig. 3.5 "
-          "was computed with d = 6e-4.")
+                           for d in prm.example1_d) + f"; d = {best_d:g} matches them best",
+        id="d_stated")
     alt = ranges[(ranges.example == 1) & (ranges.C_pen == prm.C_pen_alt)]
     if len(alt) and prm.C_pen_alt != prm.C_pen:
-        d_claim.evidence += (f" With C_pen = {prm.C_pen_alt:g} (eps = {s.eps_alt:g}) the "
+        d_claim.evidence += (f". With C_pen = {prm.C_pen_alt:g} (eps = {s.eps_alt:g}) the "
                              f"penetration is larger: max u_x {alt['max'].iloc[0]:.4e}, "
                              f"max u_y {alt['max'].iloc[1]:.4e}.")
     range1 = _ranges_claim("Figure 3.5 colorbars: u_x -0.1243e-3..0.1243e-3, u_y "
                            "0..0.5922e-3", r1[r1.d == d_main],
                            f"d = {d_main:g}, grid {prm.grid}^2, eps = {s.eps:g}, "
-                           f"{s.primary} indicator, step {prm.n_steps}")
+                           f"{s.primary} indicator, step {prm.n_steps}", "range_3_5")
     range2 = _ranges_claim("Figure 3.9 colorbars: u_x 0..0.6561e-3, u_y "
                            "-0.2003e-3..0.1762e-3 (d = 6e-4)", ranges[ranges.example == 2],
-                           f"grid {prm.grid}^2, eps = {s.eps:g}")
-    return d_claim, range1, range2, best_d
+                           f"grid {prm.grid}^2, eps = {s.eps:g}", "range_3_9")
+    d_claims = [d_claim] + ([] if d_claim.holds is not False else
+                            [c for c in (_d_explanation(s, ranges),) if c is not None])
+    return d_claims, range1, range2, best_d
 
 
-def _ranges_claim(text, rows, where):
+#: the colour-bar extremes of Fig. 3.5 that are not zero by construction (min u_y = 0 is
+#: the Dirichlet value on Gamma_D)
+NONZERO_EXTREMES = (("ux_range", "min"), ("ux_range", "max"), ("uy_range", "max"))
+
+
+def _extreme_devs(rows) -> float:
+    """Largest relative difference |ours / published - 1| of the NONZERO_EXTREMES."""
+    return max(abs(float(rows[rows.quantity == q][e].iloc[0])
+                   / float(rows[rows.quantity == q][f"published_{e}"].iloc[0]) - 1.0)
+               for q, e in NONZERO_EXTREMES)
+
+
+def _d_explanation(s: _Setup, ranges) -> Claim | None:
+    """Explanation of a failed "d = 0.6e-4" claim: the displacements are positively
+    homogeneous in d (the problem is: gap -d, penalty and Coulomb law are positively
+    homogeneous, and no contact outside the obstacle), and the colour bars are met by
+    d_main only, with either penalty parameter."""
+    prm, d_main = s.prm, s.d_main
+    r1 = ranges[ranges.example == 1]
+    others = [d for d in prm.example1_d[1:] if d != d_main]
+    if not others:
+        return None
+    main = {C: _extreme_devs(r1[(r1.d == d_main) & (r1.C_pen == C)])
+            for C in sorted(set(r1.C_pen), reverse=True)}
+    base = r1[(r1.d == d_main) & (r1.C_pen == prm.C_pen)].set_index("quantity")
+    homog, other = 0.0, {}
+    for d in others:
+        rd = r1[(r1.d == d) & (r1.C_pen == prm.C_pen)]
+        other[d] = _extreme_devs(rd)
+        rd = rd.set_index("quantity")
+        homog = max([homog] + [abs(rd.loc[q, e] * d_main / (base.loc[q, e] * d) - 1.0)
+                               for q, e in NONZERO_EXTREMES])
+    return Claim(
+        text=f"Fig. 3.5 was computed with d = {d_main:g}, not the stated 0.6e-4: the "
+             "displacements are proportional to d and only this d meets the colour bars, "
+             "whatever the penalty parameter",
+        holds=bool(homog < 1e-6 and all(v <= RANGE_TOL for v in main.values())
+                   and all(v > RANGE_TOL for v in other.values())),
+        evidence=f"extremes u_x min/max, u_y max (u_y min = 0 is the Dirichlet value) "
+                 f"against the colour bars, largest relative difference: d = {d_main:g}: "
+                 + ", ".join(f"{100 * v:.1f} % (C_pen = {C:g})" for C, v in main.items())
+                 + "; " + ", ".join(f"d = {d:g}: {100 * v:.1f} %" for d, v in other.items())
+                 + f" (tolerance {100 * RANGE_TOL:g} %); the extremes scale with d to "
+                   f"{homog:.1e} relative (same adaptive meshes: the indicators scale with d "
+                   "too)",
+        kind="explanation", id="d_colorbars", explains=("d_stated",))
+
+
+def _ranges_claim(text, rows, where, cid):
     """Both colorbar ranges (u_x, u_y) within 10 % of the published span."""
     parts = [range_claim(text, r.quantity, (r["min"], r["max"]),
                          (r.published_min, r.published_max), RANGE_TOL)
              for _, r in rows.iterrows()]
     return Claim(text=text, holds=all(c.holds for c in parts),
-                 evidence="; ".join(c.evidence for c in parts) + f" ({where})")
+                 evidence="; ".join(c.evidence for c in parts) + f" ({where})", id=cid)
 
 
 def _mids(r):
@@ -717,28 +834,31 @@ def _example2_claims(s: _Setup, ex2):
         near_top = np.linalg.norm(early - [-1.0, 0.5], axis=1) <= 0.3
         n_bot = int(sum(np.sum(np.linalg.norm(_mids(r) - [-1.0, -0.5], axis=1) <= 0.3)
                         for r in rs[:-1]))
-        claims.append(Claim(
+        claims.append(_variant(Claim(
             text="Example 2: at first most refinement happens near (-1, 1/2), none near "
                  f"(-1, -1/2) [{VARIANT_LABEL[v]}]",
             holds=bool(np.mean(near_top) >= 0.5 and n_bot == 0),
             evidence=f"steps 0-{min(3, len(rs) - 1) - 1}: {int(near_top.sum())} of "
                      f"{len(early)} refined elements within 0.3 of (-1, 1/2); over all "
                      f"steps {n_bot} within 0.3 of (-1, -1/2). Step 0 refines "
-                     + ", ".join(f"({m[0]:.3g}, {m[1]:.3g})" for m in _mids(rs[0]))))
+                     + ", ".join(f"({m[0]:.3g}, {m[1]:.3g})" for m in _mids(rs[0]))),
+            v, "early_literal"))
         late = [_mids(r) for r in rs[4:-1]]
         text = ("Example 2: after four refinement steps the indicators near (1, -1) give "
                 f"the largest contribution [{VARIANT_LABEL[v]}]")
         if late:
             late = np.vstack(late)
             near_br = np.linalg.norm(late - [1.0, -1.0], axis=1) <= 0.5
-            claims.append(Claim(
+            claims.append(_variant(Claim(
                 text=text, holds=bool(np.mean(near_br) >= 0.5),
                 evidence=f"steps 4-{len(rs) - 2}: {int(near_br.sum())} of {len(late)} "
                          "refined elements within 0.5 of (1, -1); refined midpoints "
-                         + ", ".join(f"({m[0]:.3g}, {m[1]:.3g})" for m in late)))
+                         + ", ".join(f"({m[0]:.3g}, {m[1]:.3g})" for m in late)),
+                v, "late_literal"))
         else:
-            claims.append(Claim(text=text, holds=None,
-                                evidence=f"only {len(rs) - 1} refinement steps run"))
+            claims.append(_variant(Claim(text=text, holds=None,
+                                         evidence=f"only {len(rs) - 1} refinement steps run"),
+                                   v, "late_literal"))
     res2 = ex2[s.primary][-1]["state"]["res"]
     act = res2.p_n > 0
     cpts = res2.points[act]
@@ -747,7 +867,7 @@ def _example2_claims(s: _Setup, ex2):
     geo = Claim(
         text="Example 2: the obstacle segment x = -1 + d, |y| <= 1/2 brings the body into "
              "contact (on the segment only)",
-        holds=in_seg,
+        holds=in_seg, id="contact_segment",
         evidence=(f"last mesh: {int(act.sum())} of {len(act)} contact Gauss points carry "
                   f"pressure, y in [{cpts[:, 1].min():.3g}, {cpts[:, 1].max():.3g}] on "
                   f"x = -1; total forces {res2.total_forces()[0]:.4g} (normal), "
@@ -819,12 +939,14 @@ def run(config: dict, quick: bool = False) -> list[ArtefactResult]:
     all_recs = [r for rs in list(ex1.values()) + list(ext.values()) for r in rs] + \
         [r for rs in ex2.values() for r in rs] + (ex1_alt or [])
     claims = dict(newton=_newton_claim(all_recs, ref), refine=_refinement_claims(s, ex1),
-                  adaptive=[_claim_adaptive(errtab, VARIANT_LABEL[v], ref["ndof"], prm.n_steps)
+                  adaptive=[_claim_adaptive(errtab, v, ref["ndof"], prm.n_steps)
                             for v in s.variants])
     n_ext = max(prm.n_steps, prm.n_steps_extended)
     if n_ext > prm.n_steps:
-        claims["adaptive"] += [_claim_adaptive(errtab, VARIANT_LABEL[v], ref["ndof"], n_ext,
+        claims["adaptive"] += [_claim_adaptive(errtab, v, ref["ndof"], n_ext,
                                                beyond=True) for v in s.variants]
+    units = _units_explanation(s, ext, errtab, claims["adaptive"])
+    claims["adaptive"] += [units] if units is not None else []
     claims["d"], claims["range1"], claims["range2"], best_d = _colorbar_claims(s, ranges)
     claims["ex2"], claims["geo2"] = _example2_claims(s, ex2)
     steps1, steps2, geo, init = _tables(s, ex1, ex1_alt, ex2)
@@ -864,13 +986,14 @@ def _artefacts(s: _Setup, tb, cl, recs, fields, notes, meta):
     return [
         ArtefactResult(name="figure_3_2", table=geo,
                        figure=fig_geometry(1, d_main, "Fig. 3.2 " + t1),
-                       claims=[cl["d"]], notes=notes, meta=nonan),
+                       claims=list(cl["d"]), notes=notes, meta=nonan),
         ArtefactResult(name="figure_3_3", table=tb["init"], figure=fig_initial_mesh(mesh0),
                        claims=[Claim(text="Initial mesh: four straight elements per side",
                                      holds=bool(mesh0.n_elements == 4 * 4),
                                      evidence=f"{mesh0.n_elements} elements, "
                                               f"{tb['dof0']} free DOF (the "
-                                              "thesis's coarsest uniform mesh: 22)")],
+                                              "thesis's coarsest uniform mesh: 22)",
+                                     id="initial_mesh")],
                        notes=notes, meta=nonan),
         ArtefactResult(name="figure_3_4", table=tb["steps1"],
                        figure=fig_mesh_sequence(recs1, mag, f"Fig. 3.4 (d = {d_main:g}, "
@@ -881,7 +1004,7 @@ def _artefacts(s: _Setup, tb, cl, recs, fields, notes, meta):
                        .reset_index(drop=True),
                        figure=fig_interior(X, Y, u1, mag, f"Fig. 3.5: Example 1, d = "
                                            f"{d_main:g}, after step {prm.n_steps}"),
-                       claims=[cl["range1"], cl["d"]], notes=notes, meta=nonan),
+                       claims=[cl["range1"]] + cl["d"], notes=notes, meta=nonan),
         ArtefactResult(name="figure_3_6", table=tb["errtab"],
                        figure=fig_error(tb["errtab"], f"Fig. 3.6: Example 1, d = "
                                         f"{d_main:g}; reference {tb['ref_ndof']} DOF; "
