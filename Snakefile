@@ -9,7 +9,8 @@
 # scene of an experiment module (rule `<module>__<scene>`) or a module without scenes
 # (rule = module name); it runs `python -m hpfebe run <rule>` and writes the artefacts of
 # that scene to results/.  What reruns a job (and then the report):
-#   - its module file, or an experiments/ file the module imports, changed (mtime);
+#   - its module file, or an experiments/ file the module imports, changed (its
+#     content: Snakemake compares the checksum of a small input whose mtime moved);
 #   - its module's config section, or quick/full, changed (params: the merged section);
 # nothing else: not another module's section, not README.md, not src/hpfebe (the core:
 # rerun what a core change affects with --forcerun RULE, or --forceall; every result
@@ -17,6 +18,7 @@
 # report/report.md.
 
 import json
+import math
 import os
 import shlex
 import sys
@@ -72,6 +74,7 @@ def config_flags(exp):
     return " ".join((["--quick"] if QUICK else [])
                     + [f"--config {shlex.quote(f)}" for f in files])
 
+
 # One thread per job (snakemake -j2 on 2 cores never oversubscribes): numba, OpenMP and
 # BLAS pools are pinned to the job's thread count.
 THREAD_ENV = " ".join(f"{v}={{threads}}" for v in (
@@ -115,23 +118,32 @@ def numba_input(exp):
 
 # Longest jobs first (two jobs on two cores: the run ends when its longest job does):
 # the job's wall time measured by its last run (results/<artefact>.json), else the
-# figure recorded in config/job_times.yaml (tools/job_times.py writes it from a run).
+# figure recorded in config/job_times.yaml (tools/job_times.py writes it from a full
+# run).  The recorded figures also size a cluster job (runtime, mem_mb): the SLURM
+# profile takes them from here.
 JOB_TIMES_FILE = Path(workflow.basedir) / "config" / "job_times.yaml"
 
 
-def _job_times():
+def _recorded():
     import yaml
 
-    recorded = {}
-    if JOB_TIMES_FILE.is_file():
-        recorded = (yaml.safe_load(JOB_TIMES_FILE.read_text()) or {}).get("wall_s", {})
+    if not JOB_TIMES_FILE.is_file():
+        return {}, {}
+    doc = yaml.safe_load(JOB_TIMES_FILE.read_text()) or {}
+    return doc.get("wall_s", {}), doc.get("peak_mb", {})
+
+
+RECORDED_WALL_S, RECORDED_PEAK_MB = _recorded()
+
+
+def _job_times():
     times = {}
     for job in REGISTRY.jobs:
         try:
             doc = json.loads(Path(f"{RESULTS}/{job.artefacts[0]}.json").read_text())
             times[job.rule] = float(doc["provenance"]["run"]["module_wall_time_s"])
         except (OSError, ValueError, KeyError, TypeError):
-            times[job.rule] = float(recorded.get(job.rule, 0.0))
+            times[job.rule] = float(RECORDED_WALL_S.get(job.rule, 0.0))
     return times
 
 
@@ -141,6 +153,20 @@ _ORDER = sorted(JOB_TIMES, key=lambda r: -JOB_TIMES[r])
 
 def priority_of(rule):
     return len(_ORDER) - _ORDER.index(rule) if JOB_TIMES.get(rule) else 0
+
+
+def runtime_min(rule):
+    """A cluster job's time limit, minutes: 5x the recorded wall time (a slower node, a
+    cold numba cache), at least 10 minutes; 60 for a job never measured."""
+    wall = RECORDED_WALL_S.get(rule)
+    return 60 if wall is None else max(10, math.ceil(5 * float(wall) / 60))
+
+
+def mem_mb(rule):
+    """A cluster job's memory, MB: 1.5x the recorded peak, at least 1000; 4000 for a job
+    never measured."""
+    peak = RECORDED_PEAK_MB.get(rule)
+    return 4000 if peak is None else max(1000, 100 * math.ceil(1.5 * float(peak) / 100))
 
 
 localrules: all, report
@@ -166,6 +192,9 @@ for _job in REGISTRY.jobs:
             f"{LOGS}/{_job.rule}.log",
         threads: 1
         priority: priority_of(_job.rule)
+        resources:
+            runtime=runtime_min(_job.rule),
+            mem_mb=mem_mb(_job.rule),
         params:
             rule=_job.rule,     # (the shell string is evaluated when the job runs: no _job)
             flags=config_flags(_exp),
