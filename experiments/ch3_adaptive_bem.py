@@ -9,7 +9,7 @@ Newton (:func:`hpfebe.contact.friction.solve_friction`), residual indicator (3.1
             + h_I ||d/ds (V Psi - (K + 1/2) U)||^2_{L2(I)}
 
 (:func:`hpfebe.adaptivity.bem_estimator.lame_contact_indicators`, the contact datum from
-the law of :mod:`hpfebe.contact.laws`) and Algorithm 3.2 with the maximum criterion
+the law of :mod:`hpfebe.constitutive.laws`) and Algorithm 3.2 with the maximum criterion
 eta_I >= 0.9 max eta (:func:`hpfebe.adaptivity.adapt`), p = 1 (V_h continuous piecewise
 linear (3.92), W_h piecewise constant (3.93)), initial mesh four elements per side
 (Fig. 3.3), six refinement steps (seven solves).

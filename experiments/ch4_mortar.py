@@ -46,8 +46,8 @@ from matplotlib.figure import Figure
 
 from hpfebe.analysis.rates import aitken, fitted_rate
 from hpfebe.adaptivity import adapt
-from hpfebe.contact.mortar import (contact_from_meshes, hp_refine, model_meshes, model_problem,
-                                   mortar_indicators)
+from hpfebe.adaptivity import hp_refine, mortar_indicators
+from hpfebe.contact.mortar import contact_from_meshes, model_meshes, model_problem
 from hpfebe.materials import lame_constants
 from hpfebe.params import from_config
 from hpfebe.results import CELLS_PREFIX, ArtefactResult, Claim, progress, rate_claim

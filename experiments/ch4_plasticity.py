@@ -11,7 +11,7 @@ increments; FE/FE and FE/BE (stamp by the Galerkin BEM, S_hat); deformed meshes 
 Example 2 (figure_4_6 ... figure_4_12): one touch of the stamp [-1, 1] x [-1, 0], lift
 4.2e-3; ||dev sigma|| at X = (1, -1.1).  BE/BE (figure_4_10, figure_4_11 and the BE/BE
 curve of figure_4_12): the plastic BE work piece of Section 4.2.4
-(:mod:`hpfebe.plastic_be`: Newton potentials of a cell-wise constant plastic strain,
+(:mod:`hpfebe.bodies.plastic_be`: Newton potentials of a cell-wise constant plastic strain,
 backward Euler update) under a BE stamp, every theta of 'thetas' (the figures show the
 first), mesh bebe_h.
 
@@ -19,7 +19,7 @@ Scenes (:data:`SCENES`, one workflow job each): ``ex1`` (figures 4.1-4.5) and ``
 (figures 4.6-4.12 with the locking study, BE/BE and its mesh study).
 
 Core: :mod:`hpfebe.fem.plasticity` (return map), :mod:`hpfebe.fem.plastic_body` (B-bar
-Q1 work piece), :mod:`hpfebe.contact.stamping` (touches through
+Q1 work piece), :mod:`hpfebe.scenes.stamping` (touches through
 :class:`hpfebe.contact.two_body.TwoBodyContact`).  The choices where the thesis is silent
 are :data:`CHOICES`.
 """
@@ -39,10 +39,10 @@ from matplotlib.figure import Figure
 from hpfebe.contact.loading import LU_ORDERINGS
 from hpfebe.export import fe_vtu
 from hpfebe.fem.plasticity import J2Material
-from hpfebe.contact.stamping import (ContactSettings, be_work_piece, curve_difference,
-                                 element_areas, field_difference, plastic_zone,
-                                 stamp_body, stamp_interior, touch, touch_be, work_piece,
-                                 zone_mismatch)
+from hpfebe.scenes import (ContactSettings, be_work_piece, curve_difference,
+                           element_areas, field_difference, plastic_zone,
+                           stamp_body, stamp_interior, touch, touch_be, work_piece,
+                           zone_mismatch)
 from hpfebe.params import from_config
 from hpfebe.results import ArtefactResult, Claim, progress
 

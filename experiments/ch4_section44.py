@@ -8,7 +8,7 @@ Omega_m = [-2, 2] x [-2, 0] (J2 flow with linear hardening (4.21)-(4.22),
 E = 266926, nu = 0.29, sigma_Y = 4.0, H = 450.0.
 
 Penalty (Table 4.3, Figure 4.22): FE/BE - the stamp a Galerkin BE body (P1 on the
-boundary, :class:`hpfebe.bem.lame.LameBEM` through :mod:`hpfebe.contact.stamping`), the
+boundary, :class:`hpfebe.bem.lame.LameBEM` through :mod:`hpfebe.scenes.stamping`), the
 work piece plain Q1 on the mortar part's mesh (61 x 31 cells, the thesis's 1984 nodes in
 both methods; B-bar and the uniform h_work mesh as options); Coulomb friction mu_f =
 0.2 with the penalty laws (4.19)-(4.20) (a comparison variant: the mortar's Tresca F in
@@ -53,7 +53,7 @@ import pandas as pd
 from matplotlib.collections import PolyCollection
 from matplotlib.figure import Figure
 
-from hpfebe.contact.stamping import ContactSettings, stamp_body, stamp_interior, touch
+from hpfebe.scenes import ContactSettings, stamp_body, stamp_interior, touch
 from hpfebe.fem.elasticity import rectangle_mesh
 from hpfebe.fem.plastic_body import ElastoPlasticFE
 from hpfebe.fem.plasticity import SQ23, J2Material

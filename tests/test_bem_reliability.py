@@ -66,7 +66,7 @@ def test_representation_at_nonfinite_point(op):
 
 
 def test_laplace_operator_where_lame_is_required():
-    """Lame solvers check their operator (hpfebe.contact.bodies.lame_body): a clear
+    """Lame solvers check their operator (hpfebe.bodies.body.lame_body): a clear
     ValueError, not an IndexError from the scalar traces of a LaplaceBEM."""
     from hpfebe.contact.penalty import solve_penalty
 

@@ -15,7 +15,8 @@ import pytest
 from hpfebe import BoundaryMesh
 from hpfebe.bem.lame import LameBEM
 from hpfebe.contact import solve_penalty
-from hpfebe.contact import BEBody, RigidObstacle, TwoBodyContact
+from hpfebe.bodies import BEBody, RigidObstacle
+from hpfebe.contact import TwoBodyContact
 from hpfebe.contact.friction import SLIP, STICK, solve_friction
 from hpfebe.quadrature import gauss_legendre
 from hpfebe.spaces import lagrange_values

@@ -102,7 +102,7 @@ def test_global_uzawa_coulomb_conditions(coarse):
 
 
 def test_indicators_and_hp_refine(coarse):
-    from hpfebe.contact.mortar import hp_refine, mortar_indicators
+    from hpfebe.adaptivity import hp_refine, mortar_indicators
 
     pr = coarse
     sol = pr.global_uzawa(rho=1.5, friction="coulomb", mu_f=0.1, tol=1e-8, max_iter=20000)

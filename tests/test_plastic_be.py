@@ -1,4 +1,4 @@
-"""The elastoplastic BE body (hpfebe.plastic_be, thesis Section 4.2.4, Algorithm 4.2):
+"""The elastoplastic BE body (hpfebe.bodies.plastic_be, thesis Section 4.2.4, Algorithm 4.2):
 the uniform initial-strain problem solved exactly, a homogeneous plastic state against the
 material point, a punch with a plastic zone against the plastic FE body (B-bar Q1), the
 step-size sensitivity of the forward Euler update, bad input."""
@@ -13,7 +13,7 @@ from hpfebe.fem.plastic_body import DisplacementSteps, ElastoPlasticFE
 from hpfebe.fem.plasticity import J2Material, J2State, return_map, tensor_norm
 from hpfebe.geometry import BoundaryMesh
 from hpfebe.nonlinear import load_path
-from hpfebe.plastic_be import DirichletSolver, ElastoPlasticBE, staggered_path
+from hpfebe.bodies.plastic_be import DirichletSolver, ElastoPlasticBE, staggered_path
 
 MAT = J2Material(1000.0, 0.3, 1.0, 200.0, 1.0)
 N = 4
@@ -222,7 +222,7 @@ def test_implicit_scheme_tangent_and_solution(punch_bodies):
 def test_contact_body_protocol(punch_bodies):
     """PlasticBEBody: kind "BE", internal_force = S_hat u - G(eps_p committed) with the
     dense S_hat (explicit), commit updates the plastic strain."""
-    from hpfebe.plastic_be import PlasticBEBody
+    from hpfebe.bodies.plastic_be import PlasticBEBody
     _, be0 = punch_bodies
     body = PlasticBEBody(fresh(be0))
     assert body.kind == "BE" and not body.linear and body.ndofs == be0.ndofs
@@ -245,8 +245,8 @@ def test_rectangle_work_piece_in_two_body_contact():
     moderate hardening) with TwoBodyContact: converges, the plastic zone is under the
     stamp, the bottom reaction is in equilibrium with the contact force."""
     from hpfebe.contact.two_body import TwoBodyContact
-    from hpfebe.contact.stamping import stamp_body
-    from hpfebe.plastic_be import PlasticBEBody, rectangle_work_piece
+    from hpfebe.scenes import stamp_body
+    from hpfebe.bodies.plastic_be import PlasticBEBody, rectangle_work_piece
     mat = J2Material(1000.0, 0.3, 1.0, 200.0, 1.0)
     be = rectangle_work_piece((-2, 2, -3, -1), 4, 2, mat)
     stamp = stamp_body("BE", (-1, 1, -1, 0), 1.0, mat.E, mat.nu)
@@ -270,7 +270,7 @@ def _thesis_punch(N, cells):
     """Punch of test_punch_with_plastic_zone_matches_fe_body with the thesis material
     (E / sigma_Y = 66700, H = 450: near-perfect plasticity), depth 5e-4 (~30 yield
     strains), backward Euler BE body through nonlinear.load_path."""
-    from hpfebe.plastic_be import crossed_cells
+    from hpfebe.bodies.plastic_be import crossed_cells
     fem = rectangle_mesh(-1, 1, 0, 1, 2 * N, N, "quad")
     cx = crossed_cells(fem.p.T, fem.t.T) if cells == "crossed" else CellComplex(fem.p.T, fem.t.T)
     bm = BoundaryMesh.polygon([(-1, 0), (1, 0), (1, 1), (-1, 1)], n=[2 * N, N, 2 * N, N])
@@ -322,7 +322,7 @@ def punch_fe_mat(fem, mat, depth, lams=None):
 def test_node_displacements_and_cell_lookup():
     """Uniform eps_p, traction free: the representation formula gives u = eps_hat x at
     every cell node (interior ones included); cells_at / value_at find the cells."""
-    from hpfebe.plastic_be import crossed_cells
+    from hpfebe.bodies.plastic_be import crossed_cells
     fem = rectangle_mesh(-1, 1, 0, 1, 4, 2, "quad")
     bm = BoundaryMesh.polygon([(-1, 0), (1, 0), (1, 1), (-1, 1)], n=[4, 2, 4, 2])
     be = ElastoPlasticBE(LameBEM(bm, MAT.E, MAT.nu), crossed_cells(fem.p.T, fem.t.T), MAT)
@@ -339,7 +339,7 @@ def test_node_displacements_and_cell_lookup():
         be.cells_at((5.0, 5.0))
     with pytest.raises(ValueError, match="key"):
         be.value_at("nope", (0.1, 0.3))
-    from hpfebe.plastic_be import rectangle_work_piece
+    from hpfebe.bodies.plastic_be import rectangle_work_piece
     with pytest.raises(ValueError, match="cells"):
         rectangle_work_piece((-2, 2, -3, -1), 4, 2, MAT, cells="hex")
     with pytest.raises(ValueError, match="cell_rows"):
@@ -352,7 +352,7 @@ def test_times_blocks_is_the_batched_matmul():
     |fl(a.d) - a.d| <= gamma_3 |a|.|d| with gamma_3 = 3u / (1 - 3u), for each of the two
     (the difference of two such results is within twice the bound).  Bitwise equality is
     not asserted: np.matmul may use fused multiply-adds on one CPU and not on another."""
-    from hpfebe.plastic_be import _times_blocks
+    from hpfebe.bodies.plastic_be import _times_blocks
     rng = np.random.default_rng(4)
     M = rng.standard_normal((90, 120))
     p3 = np.sort(rng.choice(120, 60, replace=False))

@@ -6,9 +6,9 @@ load step leaves the committed state untouched, bad input."""
 import numpy as np
 import pytest
 
-from hpfebe.contact.bodies import as_body
+from hpfebe.bodies import as_body
 from hpfebe.fem.elasticity import rectangle_mesh
-from hpfebe.contact.bodies import PlasticFEBody
+from hpfebe.bodies import PlasticFEBody
 from hpfebe.fem.plastic_body import DisplacementSteps, ElastoPlasticFE
 from hpfebe.fem.plasticity import J2Material, J2State, return_map
 from hpfebe.nonlinear import load_path

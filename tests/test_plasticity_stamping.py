@@ -1,4 +1,4 @@
-"""Stamping examples of Section 4.2.7 (hpfebe.contact.stamping): the plastic work piece in
+"""Stamping examples of Section 4.2.7 (hpfebe.scenes.stamping): the plastic work piece in
 penalty contact through TwoBodyContact (FE and BE stamps agree, the dent stays, the
 history of touch 1 is carried into touch 2), and figure_4_1 ... figure_4_12 through the
 command line (quick configuration)."""
@@ -12,8 +12,8 @@ import numpy as np
 import pytest
 
 from hpfebe.fem.plasticity import J2Material
-from hpfebe.contact.stamping import (ContactSettings, curve_difference, lift_schedule,
-                                 stamp_body, touch, work_piece)
+from hpfebe.scenes import (ContactSettings, curve_difference, lift_schedule,
+                           stamp_body, touch, work_piece)
 
 ROOT = Path(__file__).resolve().parents[1]
 E, NU = 266926.0, 0.29

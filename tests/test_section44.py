@@ -187,7 +187,7 @@ def test_scenes_compute_their_artefacts_only(monkeypatch):
 def _quick_touch(**friction):
     """The quick-size penalty scene (BE stamp h = 0.5, 16 x 8 Q1 work piece, 2 load
     increments) at 1/eps_n = 10 E with the given friction keywords of ContactSettings."""
-    from hpfebe.contact.stamping import ContactSettings, stamp_body, touch, work_piece
+    from hpfebe.scenes import ContactSettings, stamp_body, touch, work_piece
     from hpfebe.fem.plasticity import J2Material
 
     E, nu = 266926.0, 0.29
@@ -203,7 +203,7 @@ def test_tresca_penalty_touch_limits():
     Coulomb mu_f = 0 solution), a huge F sticks everywhere (the Coulomb solution with a
     huge mu_f), F = 0.22 (the mortar's) slips at the bound and restrains the stamp's
     lateral expansion between the two."""
-    from hpfebe.contact.laws import SLIP, STICK
+    from hpfebe.constitutive import SLIP, STICK
 
     def ux(tr):
         return float(np.abs(tr.peak.u_stamp[0::2]).max())
@@ -227,7 +227,7 @@ def test_tresca_penalty_touch_limits():
 
 
 def test_contact_settings_F():
-    from hpfebe.contact.stamping import ContactSettings
+    from hpfebe.scenes import ContactSettings
 
     s = ContactSettings()
     assert s.F is None and s.friction() == {"mu_f": 0.2}          # default: Coulomb

@@ -356,7 +356,7 @@ def test_figure_4_13_setup_smoke():
 # (measured: pressure and displacement errors 1e-15..4e-15 for p = 1, 2).
 
 from hpfebe.bem.lame import LameBEM  # noqa: E402
-from hpfebe.contact.bodies import BEBody, FEBody  # noqa: E402
+from hpfebe.bodies import BEBody, FEBody  # noqa: E402
 from hpfebe.geometry import BoundaryMesh  # noqa: E402
 
 SIDES = ["bottom", "right", "top", "left"]

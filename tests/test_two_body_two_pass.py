@@ -1,6 +1,6 @@
 """The two-pass (symmetric master-slave) penalty contact of
 hpfebe.contact.two_body.TwoBodyContact (``two_pass=True``) and its pass-through in
-hpfebe.contact.stamping.ContactSettings.
+hpfebe.scenes.stamping.ContactSettings.
 
 Scene: slave block [0, 1] x [0, 1] (4 Q1 cells across) on the master block
 [0, 1] x [-1, 0] (5 cells across; non-matching interface y = 0), E = 266926, nu = 0.29,
@@ -24,8 +24,8 @@ import dataclasses
 import numpy as np
 import pytest
 
-from hpfebe.contact.bodies import RigidObstacle
-from hpfebe.contact.stamping import ContactSettings, stamp_body, touch
+from hpfebe.bodies import RigidObstacle
+from hpfebe.scenes import ContactSettings, stamp_body, touch
 from hpfebe.contact.two_body import OPEN, SLIP, TwoBodyContact
 from hpfebe.fem.elasticity import ElasticBody, rectangle_mesh
 from hpfebe.fem.plastic_body import ElastoPlasticFE

@@ -113,7 +113,7 @@ def test_schur_inverse_by_solves_when_the_factors_reorder_the_contact_dofs():
 
 def test_fe_body_against_a_rigid_obstacle():
     """One FE body pressed onto a rigid obstacle (one block in K): both solvers agree."""
-    from hpfebe.contact.bodies import FEBody, RigidObstacle
+    from hpfebe.bodies import FEBody, RigidObstacle
 
     out = []
     for solver in ("lu", "woodbury"):

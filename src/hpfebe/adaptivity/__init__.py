@@ -9,6 +9,8 @@
   contact datum on Gamma_C.
 * :mod:`.adaptive` - the loop of Algorithm 3.2, for one mesh or several (one marking
   per mesh), with the marked elements of every step in its history.
+* :mod:`.mortar_estimator` - the hp-adaptive mortar contact of Section 4.3.5: the
+  indicator of two BE bodies in mortar contact and the h-or-p choice of Algorithm 4.6.
 """
 
 from .adaptive import AdaptiveHistory, adapt, default_refine
@@ -20,10 +22,12 @@ from .fe_estimator import energy_error_elasticity as fe_energy_error_elasticity
 from .fe_estimator import (contact_traction_datum, fe_indicators, hooke_stress, lame_stress,
                            two_body_indicators)
 from .marking import mark_bulk, mark_doerfler, mark_max
+from .mortar_estimator import hp_refine, mortar_indicators
 
 __all__ = ["AdaptiveHistory", "adapt", "default_refine", "bem_indicators",
            "boundary_residuals", "error_measure_B", "solve_laplace_mixed",
            "error_measure_B_lame", "lame_bem_indicators", "lame_boundary_residuals",
            "solve_lame_mixed", "fe_energy_error", "fe_energy_error_elasticity",
            "fe_indicators", "lame_stress", "hooke_stress", "contact_traction_datum",
-           "two_body_indicators", "mark_bulk", "mark_doerfler", "mark_max"]
+           "two_body_indicators", "mark_bulk", "mark_doerfler", "mark_max", "mortar_indicators",
+           "hp_refine"]

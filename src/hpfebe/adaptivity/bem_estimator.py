@@ -2,7 +2,7 @@
 
 Laplace (below), Lame (same indicator with vector residuals), and the contact part of
 Section 3.3.5 (end of the module): the datum P_n n + P_t t of (3.107) from the penalty
-law of :mod:`hpfebe.contact.laws`, the indicator with a weighted consistency term,
+law of :mod:`hpfebe.constitutive.laws`, the indicator with a weighted consistency term,
 |||U|||_B of a discrete penalty solution, and the error |||U_ref - U|||_B against a
 reference on a nested finer mesh.
 
@@ -58,6 +58,7 @@ import numpy as np
 import scipy.linalg as sla
 
 from ..analysis.norms import energy_error_dirichlet, energy_error_neumann, neumann_functional
+from ..constitutive.laws import penalty_friction, positive
 from ..quadrature import gauss_legendre
 from ._ongamma import grad_single_layer_on_gamma
 
@@ -271,7 +272,7 @@ def error_measure_B_lame(op, U, Psi, u_exact, traction_exact, extra: int = 3) ->
 # ----------------------------------------------------------------------------- contact
 # Contact part of (3.107) (Section 3.3.5): on Gamma_C the datum of the traction residual
 # is the penalty traction on the body, P_n n + P_t t = -p_n n - t_t t, evaluated from U at
-# the indicator's quadrature points with the one law of :mod:`hpfebe.contact.laws`
+# the indicator's quadrature points with the one law of :mod:`hpfebe.constitutive.laws`
 # (penetration U_n - g, tangential displacement U_t against a fixed obstacle).
 
 INDICATOR_VARIANTS = ("literal", "balanced")
@@ -279,11 +280,10 @@ INDICATOR_VARIANTS = ("literal", "balanced")
 
 def contact_traction(op, U, gap, eps_n: float, eps_t: float, mu_f=None, F=None, slip=0.0):
     """The datum P_n n + P_t t of (3.107) as ``f(x, n, elem, t) -> (n, 2)``: the traction
-    -p_n n - t_t t of :func:`hpfebe.contact.laws.penalty_friction` on the body, from U
+    -p_n n - t_t t of :func:`hpfebe.constitutive.laws.penalty_friction` on the body, from U
     (V_hp^2, interleaved) at the given points; ``gap(x)`` the gap function (constraint
     U_n <= g), Coulomb (``mu_f``) or Tresca (``F``), ``slip`` the accumulated slip (0:
     one load step)."""
-    from ..contact.laws import penalty_friction, positive
 
     positive("eps_n", eps_n)
     positive("eps_t", eps_t)

@@ -3,5 +3,6 @@
 from .assembly import assemble
 from .lame import LameBEM
 from .laplace import LaplaceBEM
+from .operators import BoundaryOperators
 
-__all__ = ["assemble", "LameBEM", "LaplaceBEM"]
+__all__ = ["assemble", "BoundaryOperators", "LameBEM", "LaplaceBEM"]

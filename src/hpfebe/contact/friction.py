@@ -3,7 +3,7 @@
 of :class:`hpfebe.contact.two_body.TwoBodyContact`.
 
 Discrete problem (cf. (3.95), with the tangential law (4.19)-(4.20) of
-:mod:`hpfebe.contact.laws` in place of the smoothed (3.86)): find U in V_hp^2 with U = 0
+:mod:`hpfebe.constitutive.laws` in place of the smoothed (3.86)): find U in V_hp^2 with U = 0
 on Gamma_D such that
 
     <S_hat U, v> + int_{Gamma_C} p_n v_n ds + int_{Gamma_C} t_t v_t ds = L(v)
@@ -11,7 +11,7 @@ on Gamma_D such that
 for all such v; n the outward normal, t the element tangent (n = (t_y, -t_x)), g the gap
 (admissible U_n <= g; g = -d for a rigid plane pushed into the body by d), w the
 prescribed tangential motion of the obstacle (``obstacle_slip``); sign conventions and
-the return map in :mod:`hpfebe.contact.laws` (penetration U_n - g, slip relative to w).
+the return map in :mod:`hpfebe.constitutive.laws` (penetration U_n - g, slip relative to w).
 
 Integration: Gauss-Legendre with ``nq`` points (default p_I + 1) on every element of
 Gamma_C; the contact state (pressure, stick/slip, slip history) lives at these points,
@@ -32,9 +32,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from .bodies import RigidObstacle, against_obstacle
-from .laws import OPEN, SLIP, STATE_NAMES, STICK  # noqa: F401  (re-exported)
-from .laws import positive
+from ..bodies.body import RigidObstacle, against_obstacle
+from ..constitutive.laws import OPEN, SLIP, STATE_NAMES, STICK  # noqa: F401  (re-exported)
+from ..constitutive.laws import positive
 from .two_body import ContactResult, TwoBodyContact
 
 LAWS = ("tresca", "coulomb")

@@ -16,7 +16,7 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from ..nonlinear import Iterate, SingularStep, SolverInfo
-from .laws import STATE_NAMES, updated_slip
+from ..constitutive.laws import STATE_NAMES, updated_slip
 
 MERITS = ("residual", "energy")
 #: column orderings of the sparse LU (:meth:`LoadSteps._factor`): SuperLU's default

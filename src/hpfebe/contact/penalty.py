@@ -33,8 +33,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..nonlinear import SolverInfo
-from .bodies import RigidObstacle, against_obstacle
-from .laws import positive
+from ..bodies.body import RigidObstacle, against_obstacle
+from ..constitutive.laws import positive
 from .two_body import TwoBodyContact
 
 

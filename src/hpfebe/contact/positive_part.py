@@ -7,7 +7,7 @@ the element and Gauss rules with p_I + 1 points on the positive pieces integrate
 (U_n - g_h)_+ v_n, its derivative and (U_n - g_h)_+^2 exactly.  The points depend on U:
 :meth:`ExactPositivePart.points` gives them for the current iterate, and the contact
 problem (:class:`hpfebe.contact.two_body.TwoBodyContact` with ``quadrature="exact"``)
-evaluates the one penalty law of :mod:`hpfebe.contact.laws` there.
+evaluates the one penalty law of :mod:`hpfebe.constitutive.laws` there.
 """
 
 from __future__ import annotations

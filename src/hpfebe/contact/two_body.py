@@ -8,7 +8,7 @@ Bodies.  Each body is either a P1/Q1 finite element body
 (:class:`hpfebe.bem.lame.LameBEM` on a labelled :class:`hpfebe.geometry.BoundaryMesh`).
 The contact code below is written once; what depends on the discretisation (stiffness,
 contact segments, traces at the contact points, boundary conditions and loads) comes
-from the body (:mod:`hpfebe.contact.bodies`).  A BE body's unknowns are its
+from the body (:mod:`hpfebe.bodies.body`).  A BE body's unknowns are its
 boundary displacement in V_hp^2 (interleaved components), its stiffness the dense
 discrete Steklov-Poincare operator S_hat, its traces the GLL Lagrange basis of degree p.
 
@@ -53,7 +53,7 @@ x_m = the projection and N_m the master shape functions at it,
     g_t = (u_s - u_m) . t_m                 (relative tangential displacement).
 
 Laws: the normal penalty and the Coulomb / Tresca return map of
-:mod:`hpfebe.contact.laws` with penetration d_n = -g_n and slip g_t, the traction on the
+:mod:`hpfebe.constitutive.laws` with penetration d_n = -g_n and slip g_t, the traction on the
 slave p_n n_m - t_t t_m, on the master its negative.  Weak form, with the internal contact
 force f_c(U) . V = sum_q w_q [ -p_n dg_n(V) + t_t dg_t(V) ] (w_q the quadrature weights):
 
@@ -61,7 +61,7 @@ force f_c(U) . V = sum_q w_q [ -p_n dg_n(V) + t_t dg_t(V) ] (w_q the quadrature 
 
 and the consistent tangent K + G_n^T W_n G_n + G_t^T (W_t G_t - W_tn G_n) (G_n, G_t the
 sparse maps U -> dg_n, dg_t at the points, W the diagonal law derivatives of
-:class:`hpfebe.contact.laws.LawState` times the weights): non-symmetric in slip.
+:class:`hpfebe.constitutive.laws.LawState` times the weights): non-symmetric in slip.
 
 Single pass and two passes.  The construction above is one master-slave pass, the
 thesis's Section 4.2 formulation (the gap (4.18) at slave points, the master's normal):
@@ -89,7 +89,7 @@ differ on curved or kinked interfaces.  Per-point arrays are concatenated, pass 
 first; ``passes`` (here and in :class:`ContactResult`) marks each point's pass, e.g. the
 penetration on the slave side alone is integrated with ``weights * (passes == 0)``.
 
-A rigid obstacle as master (:class:`hpfebe.contact.bodies.RigidObstacle`): the points are
+A rigid obstacle as master (:class:`hpfebe.bodies.body.RigidObstacle`): the points are
 Gauss points of the slave's contact elements, n_m = -n (n the slave's outward normal),
 t_m its tangent, g_n = g(x) - U_n, g_t = U_t - w(x): the one-body problems of Sections
 3.2-3.3 (:func:`hpfebe.contact.friction.solve_friction`).
@@ -115,9 +115,9 @@ import scipy.sparse as sp
 
 from ..nonlinear import Iterate, LineSearch, SolverInfo, load_path
 from ..quadrature import gauss_legendre
-from .bodies import as_body, pointwise
-from .laws import OPEN, SLIP, STATE_NAMES, STICK  # noqa: F401  (re-exported)
-from .laws import penalty_friction, positive, tresca_energy
+from ..bodies.body import as_body, pointwise
+from ..constitutive.laws import OPEN, SLIP, STATE_NAMES, STICK  # noqa: F401  (re-exported)
+from ..constitutive.laws import penalty_friction, positive, tresca_energy
 from .loading import LoadSteps
 from .positive_part import ExactPositivePart
 
@@ -298,7 +298,7 @@ class TwoBodyContact:
     Parameters
     ----------
     slave, master : ElasticBody (FE), LameBEM (BE), or a body of
-        :mod:`hpfebe.contact.bodies` (:class:`RigidObstacle` for the master: one body
+        :mod:`hpfebe.bodies.body` (:class:`RigidObstacle` for the master: one body
         against a rigid obstacle, Sections 3.2-3.3)
     slave_boundary, master_boundary : labels (str or list) of Gamma_C^s, Gamma_C^m
         (FE: facet labels; BE: element labels; ignored for a rigid master)

@@ -17,12 +17,12 @@ tangent assembled vectorised (numpy matmul/einsum over elements and points).
 * ``"full"``: the standard strain, fully integrated (2 x 2 Gauss on Q1, 1 point on P1);
   for the comparison curves.
 
-The body protocol of the contact problems (:mod:`hpfebe.contact.bodies`):
+The body protocol of the contact problems (:mod:`hpfebe.bodies.body`):
 ``internal_force(u) -> (f_int, tangent)`` is a pure function of u and the *committed*
 history (trial return map), ``commit(u)`` makes the state at u the committed history (call
 it only after a load step converged); a failed, cut load step therefore restarts from the
 committed state automatically.  :class:`PlasticFEBody` wraps the body as a contact
-:class:`~hpfebe.contact.bodies.FEBody` (kind "FE", segments, traces, dofs ...).
+:class:`~hpfebe.bodies.body.FEBody` (kind "FE", segments, traces, dofs ...).
 
 :class:`DisplacementSteps` is the :class:`hpfebe.nonlinear.LoadStep` of a body alone under
 prescribed displacements and loads (no contact), for :func:`hpfebe.nonlinear.load_path`.

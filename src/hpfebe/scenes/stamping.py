@@ -39,9 +39,10 @@ from ..geometry import BoundaryMesh
 from ..fem.elasticity import ElasticBody, rectangle_mesh
 from ..fem.plastic_body import ElastoPlasticFE
 from ..fem.plasticity import J2Material
-from .bodies import BEBody, PlasticFEBody
-from .loading import LU_ORDERINGS
-from .two_body import TwoBodyContact
+from ..bodies import BEBody, PlasticBEBody, PlasticFEBody
+from ..bodies.plastic_be import rectangle_work_piece
+from ..contact.loading import LU_ORDERINGS
+from ..contact.two_body import TwoBodyContact
 
 SIDES = ("bottom", "right", "top", "left")
 STAMP_KINDS = ("FE", "BE")
@@ -347,9 +348,8 @@ def curve_difference(a, b) -> float:
 def be_work_piece(box, h: float, material: J2Material, cells: str = "crossed"):
     """The elastoplastic BE work piece (thesis Section 4.2.4) on ``box`` with mesh size h:
     a degree-1 LameBEM and cells of size h carrying the plastic strain
-    (:func:`hpfebe.plastic_be.rectangle_work_piece`, backward Euler ("implicit")
+    (:func:`hpfebe.bodies.plastic_be.rectangle_work_piece`, backward Euler ("implicit")
     update)."""
-    from ..plastic_be import rectangle_work_piece
     x0, x1, y0, y1 = box
     return rectangle_work_piece(box, _cells(x1 - x0, h), _cells(y1 - y0, h), material,
                                 scheme="implicit", cells=cells)
@@ -358,13 +358,12 @@ def be_work_piece(box, h: float, material: J2Material, cells: str = "crossed"):
 def touch_be(stamp, be, u_total: float, n_load: int, X, settings: ContactSettings,
              touch_id: int = 1) -> TouchResult:
     """One loading touch (no unloading) of the stamp on the elastoplastic BE work piece
-    ``be`` (:class:`hpfebe.plastic_be.ElastoPlasticBE`, contact body
-    :class:`~hpfebe.plastic_be.PlasticBEBody`): the schedule, predictor and stopping
+    ``be`` (:class:`hpfebe.bodies.plastic_be.ElastoPlasticBE`, contact body
+    :class:`~hpfebe.bodies.plastic_be.PlasticBEBody`): the schedule, predictor and stopping
     rule of :func:`touch`.  Records: the bottom reaction (S_hat u - G(tau) summed over
     the bottom y dofs), ||dev sigma|| and ||eps_p|| of the cells touching X.  The
     snapshot's ``u_work`` is the BE boundary displacement; its ``fields`` the cell fields
     plus the cell-node displacement ``node_u`` (representation formula)."""
-    from ..plastic_be import PlasticBEBody
     body = PlasticBEBody(be)
     pr, fixed, is_y = _stamp_on_work(stamp, body, be.material.E, settings)
     by_local = body.dofs_on("bottom", 1)

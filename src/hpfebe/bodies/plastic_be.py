@@ -4,12 +4,10 @@ S_hat of :class:`hpfebe.bem.lame.LameBEM`, the plastic strain piecewise constant
 of the work piece (:class:`hpfebe.fem.newton_potential.CellComplex`), updated from the
 cell-average strain by the J2 return map (:mod:`hpfebe.fem.plasticity`).
 
-Placed between :mod:`hpfebe.bem` and the contact problems: it needs the boundary
+A body of :mod:`hpfebe.bodies`, below the contact problems: it needs the boundary
 operators, the Newton potential of :mod:`hpfebe.fem.newton_potential` and the J2 return
-map; :class:`PlasticBEBody` (the contact-body wrapper, like
-:class:`hpfebe.contact.bodies.PlasticFEBody`) uses only :mod:`hpfebe.contact.bodies`
-(which does not import this module), so :mod:`hpfebe.contact.stamping` can use it
-without an import cycle.
+map; :class:`PlasticBEBody` is its contact-body wrapper (like
+:class:`hpfebe.bodies.body.PlasticFEBody`).
 
 **The boundary equation (4.29).**  With tau = C : eps_p (in-plane), the weak form of
 div sigma = 0, sigma = C : (eps(u) - eps_p), tested with the elastic extension Phi~ of a
@@ -46,7 +44,7 @@ operator (measured, N = 4 punch).
 **Algorithm 4.2** (forward Euler in eps_p, backward Euler for contact): the matrix is
 S_hat alone; the plastic strain enters the right-hand side.  ``internal_force(u)``
 returns (S_hat u - G tau(eps_p committed), S_hat): a pure function of u and the committed
-history (the body protocol of :mod:`hpfebe.contact.bodies`), and ``commit(u)`` performs
+history (the body protocol of :mod:`hpfebe.bodies.body`), and ``commit(u)`` performs
 the return map per cell (cell-average strain) from the committed state with the strain at u -
 the plastic strain is one load step behind (explicit), so the result depends on the step
 size (tests/test_plastic_be.py measures it).  ``staggered_step`` iterates the update
@@ -78,14 +76,14 @@ import numpy as np
 import scipy.linalg as sla
 import scipy.sparse as sp
 
-from .bem.lame import LameBEM
-from .bem.potentials import POT_LAME_DL, evaluate_potential
-from .geometry import BoundaryMesh
-from .contact.bodies import BEBody
-from .fem.newton_potential import (CellComplex, edge_integrals, initial_stress,
+from ..bem.lame import LameBEM
+from ..bem.potentials import POT_LAME_DL, evaluate_potential
+from ..geometry import BoundaryMesh
+from ..fem.newton_potential import (CellComplex, edge_integrals, initial_stress,
                                    kelvin_constants, newton_operators)
-from .fem.plasticity import J2Material, J2State, embed_plane, return_map, tensor_norm, dev
-from .nonlinear import Iterate, LineSearch, SingularStep, fixed_point, newton
+from .body import BEBody
+from ..fem.plasticity import J2Material, J2State, embed_plane, return_map, tensor_norm, dev
+from ..nonlinear import Iterate, LineSearch, SingularStep, fixed_point, newton
 
 GAUSS_EDGE = 4
 SCHEMES = ("explicit", "implicit")
@@ -641,11 +639,11 @@ def rectangle_work_piece(box, nx: int, ny: int, material: J2Material,
                          cell_rows: int | None = None) -> ElastoPlasticBE:
     """The BE work piece on ``box`` = (x0, x1, y0, y1): a degree-1 LameBEM (plane
     strain, sides labelled bottom/right/top/left as the FE meshes of
-    :mod:`hpfebe.contact.stamping`) and nx x ny rectangular cells carrying eps_p
+    :mod:`hpfebe.scenes.stamping`) and nx x ny rectangular cells carrying eps_p
     (``cells="crossed"``: each split into four triangles, :func:`crossed_cells`);
     ``cell_rows``: only the top ``cell_rows`` rows of cells (the region where plastic
     strain can appear; default all ny)."""
-    from .fem.elasticity import rectangle_mesh
+    from ..fem.elasticity import rectangle_mesh
     for name, v in (("nx", nx), ("ny", ny)):
         if isinstance(v, bool) or int(v) != v or v < 1:
             raise ValueError(f"{name} must be a positive integer, got {v!r}")
