@@ -17,11 +17,15 @@
 # records the git commit it was built from).  `rule report` builds report/index.html and
 # report/report.md.
 
+import atexit
 import json
 import math
 import os
 import shlex
+import socket
 import sys
+import threading
+import time
 from pathlib import Path
 
 configfile: "config/config.yaml"
@@ -89,7 +93,76 @@ PYTHON = shlex.quote(sys.executable)
 # changes on every call must not be part of a job's command, inputs or params (Snakemake
 # would rerun every job every time).  After an interrupted run: `snakemake --unlock`,
 # then rerun (see README, "Reliability").
-os.environ["HPFEBE_PARENT_PID"] = str(os.getpid())
+# On a cluster a job runs under nested Snakemakes that read this file again (SLURM:
+# sbatch -> snakemake -> srun -> snakemake -> the job): only the main Snakemake sets the
+# variables, the nested ones pass on what they inherited (sbatch --export=ALL).  A job
+# on the main Snakemake's host watches its pid; a job on another host watches the
+# heartbeat file that the main Snakemake rewrites every second (onstart below: where jobs
+# run elsewhere), and stops when it has not changed for 10 s (hpfebe.cli
+# HEARTBEAT_TIMEOUT_S, watch_heartbeat).
+if workflow.is_main_process:
+    os.environ["HPFEBE_PARENT_PID"] = str(os.getpid())
+    os.environ["HPFEBE_PARENT_HOST"] = socket.gethostname()
+
+
+def _main_snakemake_gone():
+    """True if the main Snakemake named by the environment has ended (its pid on this
+    host, else its heartbeat file older than 10 s: hpfebe.cli.watch_heartbeat)."""
+    pid, host = os.environ.get("HPFEBE_PARENT_PID"), os.environ.get("HPFEBE_PARENT_HOST")
+    if not pid:
+        return False
+    if host and host != socket.gethostname():
+        heartbeat = os.environ.get("HPFEBE_HEARTBEAT")
+        try:
+            return bool(heartbeat) and time.time() - os.stat(heartbeat).st_mtime > 10
+        except OSError:
+            return True
+    try:
+        os.kill(int(pid), 0)
+    except ProcessLookupError:
+        return True
+    except (PermissionError, ValueError):
+        pass
+    return False
+
+
+# A cluster job that starts after its main Snakemake was killed (it waited in the queue)
+# stops here, before its Snakemake removes the job's old outputs to rebuild them.
+if not workflow.is_main_process and _main_snakemake_gone():
+    raise WorkflowError("the Snakemake that submitted this job has ended: the job does "
+                        "not run (after an interrupted run: snakemake --unlock, then rerun)")
+
+
+_HEARTBEAT_STOP = threading.Event()
+
+
+def _heartbeat(path):
+    beat = 0
+    while not _HEARTBEAT_STOP.wait(1.0):
+        beat += 1
+        try:
+            path.write_text(f"{beat}\n")
+        except OSError:       # a full or briefly unavailable file system: try again
+            pass
+
+
+def _end_heartbeat(path):
+    _HEARTBEAT_STOP.set()
+    path.unlink(missing_ok=True)
+
+
+onstart:
+    if workflow.non_local_exec:      # (known here, not yet when this file is read)
+        _hb = Path(".snakemake", "hpfebe", f"heartbeat.{socket.gethostname()}.{os.getpid()}")
+        _hb.parent.mkdir(parents=True, exist_ok=True)
+        for _old in _hb.parent.glob(f"heartbeat.{socket.gethostname()}.*"):  # kill -9
+            if not Path("/proc", _old.suffix[1:]).exists():
+                _old.unlink(missing_ok=True)
+        _hb.write_text("0\n")
+        os.environ["HPFEBE_HEARTBEAT"] = str(_hb.resolve())
+        threading.Thread(target=_heartbeat, args=(_hb,), name="hpfebe-heartbeat",
+                         daemon=True).start()
+        atexit.register(_end_heartbeat, _hb)
 
 
 def artefact_outputs(artefacts):
@@ -155,6 +228,31 @@ def priority_of(rule):
     return len(_ORDER) - _ORDER.index(rule) if JOB_TIMES.get(rule) else 0
 
 
+def slurm_nice(rule):
+    """The job's `sbatch --nice` (a resource function: the profile's --groups are known
+    when the jobs are made, not when this file is read): the number of jobs measured
+    longer, times the number of jobs.  The SLURM executor does not pass Snakemake's
+    priority on; SLURM starts jobs of equal priority in the order of submission, which is
+    not this one, and (priority/basic) lowers each job's priority by 1 against the one
+    before: a step of 1 per place would not outweigh that.  A job of a group (profiles/
+    slurm: small jobs run one after another as one SLURM job) counts as long as its
+    share of the group, and all jobs of a group get the same value (Snakemake refuses a
+    group whose jobs ask for different strings)."""
+
+    def nice(wildcards):
+        groups = workflow.group_settings.overwrite_groups
+        wall = JOB_TIMES.get(rule, 0.0)
+        if rule in groups:
+            members = [r for r, g in groups.items() if g == groups[rule]]
+            parts = math.ceil(len(members) / workflow.group_settings.group_components.get(
+                groups[rule], 1))
+            wall = sum(JOB_TIMES.get(r, 0.0) for r in members) / parts
+        longer = sum(t > wall for r, t in JOB_TIMES.items() if r not in groups)
+        return f"--nice={len(JOB_TIMES) * longer if wall else len(JOB_TIMES) ** 2}"
+
+    return nice
+
+
 def runtime_min(rule):
     """A cluster job's time limit, minutes: 5x the recorded wall time (a slower node, a
     cold numba cache), at least 10 minutes; 60 for a job never measured."""
@@ -195,6 +293,7 @@ for _job in REGISTRY.jobs:
         resources:
             runtime=runtime_min(_job.rule),
             mem_mb=mem_mb(_job.rule),
+            slurm_extra=slurm_nice(_job.rule),
         params:
             rule=_job.rule,     # (the shell string is evaluated when the job runs: no _job)
             flags=config_flags(_exp),

@@ -342,6 +342,48 @@ def test_job_stops_when_its_parent_is_killed(tmp_path):
     assert not target.exists() and not list(tmp_path.glob(".*.tmp"))
 
 
+HEARTBEAT_WRITER = SLOW_WRITER.replace(
+    "cli._watch_parent_from_env()",
+    "cli.watch_heartbeat(sys.argv[2], timeout=1.5, interval=0.1)")
+
+
+def test_job_stops_when_the_heartbeat_stops(tmp_path):
+    """A cluster job on another node than its Snakemake watches the heartbeat file that
+    the Snakemake rewrites every second (Snakefile, onstart): when the file stops
+    changing, the job stops and leaves no temporary file."""
+    heartbeat = tmp_path / "heartbeat"
+    heartbeat.write_text("0\n")
+    target = tmp_path / "table_9_9.csv"
+    p = subprocess.Popen([sys.executable, "-c", HEARTBEAT_WRITER, str(target),
+                          str(heartbeat)], stdout=subprocess.PIPE, text=True)
+    assert p.stdout.readline().startswith("writing")
+    for beat in range(1, 9):               # 4 s of heartbeats: the job runs on
+        heartbeat.write_text(f"{beat}\n")
+        time.sleep(0.5)
+        assert p.poll() is None, "the job stopped while the heartbeat went on"
+    t0 = time.monotonic()
+    assert p.wait(timeout=30) == 128 + signal.SIGTERM
+    assert time.monotonic() - t0 < 1.5 + 2
+    assert not target.exists() and not list(tmp_path.glob(".*.tmp"))
+
+
+def test_job_on_another_host_watches_the_heartbeat(tmp_path):
+    """The Snakemake runs on another host (HPFEBE_PARENT_HOST): its pid means nothing
+    here, the heartbeat file decides; one last written a minute ago stops the job
+    before it computes, although the pid given is alive on this host."""
+    heartbeat = tmp_path / "heartbeat"
+    heartbeat.write_text("1\n")
+    old = time.time() - 60
+    os.utime(heartbeat, (old, old))
+    env = dict(os.environ, HPFEBE_PARENT_PID=str(os.getpid()),
+               HPFEBE_PARENT_HOST="elsewhere.invalid", HPFEBE_HEARTBEAT=str(heartbeat))
+    r = subprocess.run([sys.executable, "-m", "hpfebe", "run", "figure_bem_laplace",
+                        "--quick", "--out", str(tmp_path / "out")], cwd=ROOT, env=env,
+                       capture_output=True, text=True, timeout=120)
+    assert r.returncode == 2 and "s old" in r.stderr, r.stderr
+    assert not (tmp_path / "out").exists()
+
+
 @pytest.mark.parametrize("p", [True, 2.7, 0, np.nan, "2"])
 def test_basis_degree_never_truncated(p):
     from hpfebe.spaces import lagrange_values, legendre_values

@@ -95,9 +95,16 @@ class JitTimer:
 
 
 # --------------------------------------------------------------------------- signals
-#: environment variable naming the process whose death stops a run (set by the
-#: Snakefile to the Snakemake process running the job)
+#: environment variables naming the Snakemake whose death stops a run (set by the
+#: Snakefile in the main Snakemake; a cluster job inherits them through the nested
+#: Snakemakes that run it): its process id, its host, and (cluster runs) the heartbeat
+#: file it rewrites every second, watched by a job on another host
 PARENT_PID_ENV = "HPFEBE_PARENT_PID"
+PARENT_HOST_ENV = "HPFEBE_PARENT_HOST"
+HEARTBEAT_ENV = "HPFEBE_HEARTBEAT"
+#: seconds without a change of the heartbeat file after which its Snakemake is taken for
+#: dead (it is rewritten every second; a shared file system may show a change late)
+HEARTBEAT_TIMEOUT_S = 10.0
 
 
 class Terminated(BaseException):
@@ -148,26 +155,17 @@ def _alive(pid: int, start: str | None) -> bool:
     return True
 
 
-def watch_parent(pid: int, interval: float = 1.0, grace: float = 30.0):
-    """Stop this run when process ``pid`` ends (Snakemake killed, even by SIGKILL, must
-    not leave its jobs running on as orphans writing into results/): a daemon thread
-    polls it every ``interval`` seconds and, when it is gone, sends this process
-    SIGTERM (see :func:`install_signal_handlers`); if the main thread has not ended
-    ``grace`` seconds later (stuck in compiled code), the temporaries are removed and
-    the process exits hard with status 143.  Returns the thread; CLIError if ``pid`` is
-    not running now (its Snakemake ended before this job started)."""
+def _stop_when(gone, why: str, interval: float, grace: float):
+    """A daemon thread that polls ``gone()`` every ``interval`` seconds and, when it is
+    true, sends this process SIGTERM (see :func:`install_signal_handlers`); if the main
+    thread has not ended ``grace`` seconds later (stuck in compiled code), the
+    temporaries are removed and the process exits hard with status 143."""
     import threading
 
-    start = _start_time(pid)
-    if not _alive(pid, start):
-        raise CLIError(f"{PARENT_PID_ENV}={pid} names a process that has ended: the "
-                       "Snakemake that started this job is gone, so the job does not run "
-                       f"(to run the command by hand, leave out {PARENT_PID_ENV})")
-
     def loop():
-        while _alive(pid, start):
+        while not gone():
             time.sleep(interval)
-        log.warning("parent process %d is gone: stopping this run", pid)
+        log.warning("%s: stopping this run", why)
         os.kill(os.getpid(), signal.SIGTERM)
         time.sleep(grace)
         from .results import remove_temporaries
@@ -180,7 +178,64 @@ def watch_parent(pid: int, interval: float = 1.0, grace: float = 30.0):
     return t
 
 
+def watch_parent(pid: int, interval: float = 1.0, grace: float = 30.0):
+    """Stop this run when process ``pid`` ends (Snakemake killed, even by SIGKILL, must
+    not leave its jobs running on as orphans writing into results/); see
+    :func:`_stop_when`.  Returns the thread; CLIError if ``pid`` is not running now (its
+    Snakemake ended before this job started)."""
+    start = _start_time(pid)
+    if not _alive(pid, start):
+        raise CLIError(f"{PARENT_PID_ENV}={pid} names a process that has ended: the "
+                       "Snakemake that started this job is gone, so the job does not run "
+                       f"(to run the command by hand, leave out {PARENT_PID_ENV})")
+    return _stop_when(lambda: not _alive(pid, start), f"parent process {pid} is gone",
+                      interval, grace)
+
+
+def _heartbeat_state(path: Path):
+    """What changes at each heartbeat: the file's content and mtime (the content is read,
+    not only stat'ed: opening a file revalidates NFS's cached attributes)."""
+    try:
+        with open(path, "rb") as f:
+            return f.read(64), os.fstat(f.fileno()).st_mtime_ns
+    except OSError:
+        return None
+
+
+def watch_heartbeat(path: Path, timeout: float = HEARTBEAT_TIMEOUT_S,
+                    interval: float = 1.0, grace: float = 30.0):
+    """Stop this run when the heartbeat file ``path`` has not changed for ``timeout``
+    seconds (by this host's clock): the Snakemake on another host that rewrites it every
+    second is gone.  CLIError if the file is missing or was last written more than
+    ``timeout`` seconds ago (by the file server's clock) when the job starts."""
+    path = Path(path)
+    try:
+        age = time.time() - path.stat().st_mtime
+    except OSError:
+        age = None
+    if age is None or age > timeout:
+        raise CLIError(f"{HEARTBEAT_ENV}={path} is " + ("missing" if age is None else
+                       f"{age:.0f} s old") + ": the Snakemake that started this job is "
+                       f"gone, so the job does not run (to run the command by hand, leave "
+                       f"out {PARENT_PID_ENV})")
+    last = [_heartbeat_state(path), time.monotonic()]
+
+    def gone():
+        state = _heartbeat_state(path)
+        if state is not None and state != last[0]:
+            last[:] = [state, time.monotonic()]
+        return time.monotonic() - last[1] > timeout
+
+    return _stop_when(gone, f"the heartbeat {path} stopped {timeout:.0f} s ago",
+                      interval, grace)
+
+
 def _watch_parent_from_env() -> None:
+    """The job watch: the parent Snakemake's pid where it runs on this host (the local
+    executor; a cluster job on the submit host), else its heartbeat file (a cluster job
+    on another node; the file is on the file system shared with it)."""
+    import socket
+
     value = os.environ.get(PARENT_PID_ENV)
     if not value:
         return
@@ -188,6 +243,17 @@ def _watch_parent_from_env() -> None:
         pid = int(value)
     except ValueError:
         log.warning("%s=%r is not a process id; ignored", PARENT_PID_ENV, value)
+        return
+    host = os.environ.get(PARENT_HOST_ENV)
+    if host and host != socket.gethostname():
+        heartbeat = os.environ.get(HEARTBEAT_ENV)
+        if heartbeat:
+            watch_heartbeat(Path(heartbeat))
+            log.info("this run stops when %s (the heartbeat of the Snakemake that started "
+                     "it, on %s) stops", heartbeat, host)
+        else:
+            log.warning("the Snakemake that started this job runs on %s and writes no "
+                        "heartbeat (%s): this job is not watched", host, HEARTBEAT_ENV)
         return
     if pid > 1 and pid != os.getpid():
         watch_parent(pid)
