@@ -116,6 +116,15 @@ trap 'exit 143' TERM HUP
 [[ -f "${REPO}/Snakefile" && -d "${REPO}/profiles/slurm" ]] \
     || die "${REPO} is not the hpfebe repository"
 
+# One run at a time on a machine (one /etc/slurm/slurm.conf, SLURM's ports, the pid files
+# in WORK): a second run waits for the first to end (30 min at most).
+LOCK=/tmp/hpfebe-slurm_local.lock
+exec 9>"${LOCK}"
+if ! flock -n 9; then
+    echo "slurm_local: another run of this script holds ${LOCK}: waiting for it"
+    flock -w 1800 9 || die "another run of this script still holds ${LOCK} after 30 min"
+fi
+
 # ------------------------------------------------------------------ 1. install
 step "install SLURM and munge"
 if ! command -v slurmctld >/dev/null || ! command -v slurmd >/dev/null \
@@ -152,8 +161,9 @@ pip show snakemake-executor-plugin-slurm 2>/dev/null | grep -E '^(Name|Version)'
 
 # ------------------------------------------------------------------ 2. daemons
 step "start munged"
-# Daemons left by an earlier run of this script that was killed outright (no trap ran):
-# only those whose pid file is in WORK, and only if the pid still runs that program.
+# Daemons left by an earlier run of this script that was killed outright (no trap ran;
+# that run no longer holds the lock): only those whose pid file is in WORK, and only if
+# the pid still runs that program.
 for d in slurmd slurmctld; do
     if [[ -f "${WORK}/${d}.pid" ]]; then
         pid="$(cat "${WORK}/${d}.pid")"
@@ -176,7 +186,7 @@ else
     chown munge:munge /etc/munge/munge.key
     chmod 0400 /etc/munge/munge.key
     rm -f /run/munge/munged.pid
-    runuser -u munge -- /usr/sbin/munged     # forks into the background
+    runuser -u munge -- /usr/sbin/munged 9>&-   # forks into the background
     for ((i = 0; i < 50; i++)); do
         [[ -s /run/munge/munged.pid ]] && break
         sleep 0.1
@@ -236,10 +246,11 @@ NodeName=${NODE} NodeAddr=127.0.0.1 CPUs=${CPUS} RealMemory=${MEM} State=UNKNOWN
 PartitionName=debug Nodes=${NODE} Default=YES MaxTime=INFINITE State=UP
 ${HPFEBE_SLURM_CONF_EXTRA:-}
 EOF
-# -D: in the foreground of a background process, so that $! is the daemon
-slurmctld -D -c -f "${CONF}" >"${WORK}/log/slurmctld.out" 2>&1 &
+# -D: in the foreground of a background process, so that $! is the daemon; 9>&-: a
+# daemon left running (this script killed outright) does not hold the lock
+slurmctld -D -c -f "${CONF}" >"${WORK}/log/slurmctld.out" 2>&1 9>&- &
 STARTED_PIDS+=($!); STARTED_NAMES+=(slurmctld)
-slurmd -D -f "${CONF}" -N "${NODE}" >"${WORK}/log/slurmd.out" 2>&1 &
+slurmd -D -f "${CONF}" -N "${NODE}" >"${WORK}/log/slurmd.out" 2>&1 9>&- &
 STARTED_PIDS+=($!); STARTED_NAMES+=(slurmd)
 state=""
 for ((i = 0; i < 300; i++)); do
