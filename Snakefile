@@ -319,7 +319,7 @@ rule report:
     input:
         results=ALL_RESULTS,
         published=sorted(str(p) for p in Path("report/published").glob("*.csv")),
-        builder=["src/hpfebe/report.py", "src/hpfebe/results.py"],
+        builder=sorted(str(p) for p in Path("src/hpfebe/suite").glob("*.py")),
     output:
         html="report/index.html",
         md="report/report.md",

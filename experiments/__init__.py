@@ -10,7 +10,7 @@ is computed once)::
     \"\"\"Which thesis section and equations; every choice made where the thesis is
     silent (these choices are also repeated in the results' ``notes``).\"\"\"
 
-    from hpfebe.results import ArtefactResult, Claim, progress
+    from hpfebe.suite.results import ArtefactResult, Claim, progress
 
     ARTEFACTS = ("table_2_1", "table_2_2", "figure_2_2")   # ids as in EXPERIMENTS.md
 
@@ -28,11 +28,11 @@ Rules
   ``config/quick.yaml`` is merged over it (nested dicts merged, other values replaced).
   A missing section gives ``{}``.  ``quick`` is True in quick mode, for anything the
   config does not already say.
-* ``run`` returns one :class:`hpfebe.results.ArtefactResult` per entry of
+* ``run`` returns one :class:`hpfebe.suite.results.ArtefactResult` per entry of
   ``ARTEFACTS`` (no more, no fewer).  It does not write files: ``hpfebe run`` validates
-  all results first and then writes them (:func:`hpfebe.results.write_result`), so a
+  all results first and then writes them (:func:`hpfebe.suite.results.write_result`), so a
   contract breach never leaves half a set.  Meshes and fields for ParaView go into
-  ``ArtefactResult.exports`` ({key: meshio.Mesh}, built with :mod:`hpfebe.export`) and
+  ``ArtefactResult.exports`` ({key: meshio.Mesh}, built with :mod:`hpfebe.io.vtu`) and
   are written as ``results/<id>_<key>.vtu``.
 * ``table``: the published columns first, with the same names as in
   ``report/published/<published>``, then what else was measured (``dof``,
@@ -45,7 +45,7 @@ Rules
   sweep, a solver that did not converge).
 * ``claims``: checked statements, each with ``holds`` = True / False / None (not
   decidable here, e.g. evaluated over zero converged runs: never True) and the measured
-  ``evidence``, and a ``kind`` (:data:`hpfebe.results.CLAIM_KINDS`): ``thesis`` (a
+  ``evidence``, and a ``kind`` (:data:`hpfebe.suite.results.CLAIM_KINDS`): ``thesis`` (a
   statement the thesis makes; the report's summary counts these), ``explanation`` (our
   computed test of a cause for a difference: one that could have failed, and survives
   the changes it should not depend on), ``hypothesis`` (a coincidence or reading not

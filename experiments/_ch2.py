@@ -13,7 +13,7 @@ import pandas as pd
 
 from hpfebe.analysis.rates import observed_rates
 from hpfebe.coupling.errors import lambda_sweep
-from hpfebe.results import progress
+from hpfebe.suite.results import progress
 
 logging.getLogger("skfem").setLevel(logging.WARNING)  # one INFO line per assembly otherwise
 

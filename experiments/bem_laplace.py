@@ -33,8 +33,8 @@ from matplotlib.figure import Figure
 from hpfebe import BoundaryMesh
 from hpfebe.analysis import boundary_l2_error, observed_rates
 from hpfebe.bem import LaplaceBEM
-from hpfebe.params import from_config
-from hpfebe.results import ArtefactResult, joint_claim, progress, rate_claim
+from hpfebe.suite.params import from_config
+from hpfebe.suite.results import ArtefactResult, joint_claim, progress, rate_claim
 
 ARTEFACTS = ("figure_bem_laplace",)
 

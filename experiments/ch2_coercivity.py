@@ -25,8 +25,8 @@ from matplotlib.figure import Figure
 from hpfebe.coupling import NitscheFEBE, problem
 from hpfebe.coupling.coercivity import (coercivity_threshold, inverse_constant,
                                         lemma_2_2_3_bound)
-from hpfebe.params import from_config
-from hpfebe.results import ArtefactResult, Claim, progress
+from hpfebe.suite.params import from_config
+from hpfebe.suite.results import ArtefactResult, Claim, progress
 
 ARTEFACTS = ("figure_coercivity",)
 

@@ -29,8 +29,8 @@ from matplotlib.tri import Triangulation
 
 from hpfebe.coupling import NitscheFEBE, problem
 from hpfebe.coupling.errors import be_solution_at
-from hpfebe.params import from_config
-from hpfebe.results import ArtefactResult, Claim, joint_claim, rate_claim
+from hpfebe.suite.params import from_config
+from hpfebe.suite.results import ArtefactResult, Claim, joint_claim, rate_claim
 
 from experiments._ch2 import KEYS, add_slope, compare, last, part_table, sweep
 

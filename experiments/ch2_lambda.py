@@ -26,8 +26,8 @@ from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter
 
 from hpfebe.coupling import NitscheFEBE, problem
 from hpfebe.coupling.coercivity import coercivity_threshold
-from hpfebe.params import from_config
-from hpfebe.results import ArtefactResult, Claim
+from hpfebe.suite.params import from_config
+from hpfebe.suite.results import ArtefactResult, Claim
 
 from experiments._ch2 import add_slope, rates, sweep
 

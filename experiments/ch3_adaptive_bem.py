@@ -53,10 +53,11 @@ from hpfebe.adaptivity.bem_estimator import (INDICATOR_VARIANTS, consistency_wei
                                              lame_contact_indicators, norm_B, true_error)
 from hpfebe.bem.lame import LameBEM
 from hpfebe.contact.friction import solve_friction
-from hpfebe.export import boundary_vtu
+from hpfebe.io.vtu import boundary_vtu
 from hpfebe.geometry import common_refinement
-from hpfebe.params import FrictionalContactScene, from_config
-from hpfebe.results import ArtefactResult, Claim, beats_uniform_claim, range_claim
+from hpfebe.scenes.materials import FrictionalContactScene
+from hpfebe.suite.params import from_config
+from hpfebe.suite.results import ArtefactResult, Claim, beats_uniform_claim, range_claim
 
 ARTEFACTS = ("figure_3_2", "figure_3_3", "figure_3_4", "figure_3_5", "figure_3_6",
              "figure_3_7", "figure_3_8", "figure_3_9")

@@ -33,9 +33,9 @@ from matplotlib.ticker import NullFormatter
 from hpfebe.analysis import aitken, energy_norm, observed_rates
 from hpfebe.contact import solve_penalty
 from hpfebe.contact.limits import square_body
-from hpfebe.materials import PLANES
-from hpfebe.params import from_config
-from hpfebe.results import ArtefactResult, Claim, progress, rate_claim
+from hpfebe.constitutive.materials import PLANES
+from hpfebe.suite.params import from_config
+from hpfebe.suite.results import ArtefactResult, Claim, progress, rate_claim
 
 ARTEFACTS = ("table_3_1", "figure_3_1")
 

@@ -50,8 +50,8 @@ from hpfebe.analysis import energy_norm, fitted_rate, observed_rates
 from hpfebe.contact import solve_penalty
 from hpfebe.contact.limits import (MACHEPS, constrained_limit, saturation_index,
                                    singular_exponent, solve_penalty_checked, square_body)
-from hpfebe.params import from_config
-from hpfebe.results import ArtefactResult, Claim, progress, rate_claim
+from hpfebe.suite.params import from_config
+from hpfebe.suite.results import ArtefactResult, Claim, progress, rate_claim
 from hpfebe.spaces import prolongate
 
 from experiments.ch3_penalty import PUBLISHED_ULIM
@@ -573,7 +573,7 @@ def flat_claims(st_df: pd.DataFrame, summ: dict) -> list[Claim]:
                 "). The displacement stays close to the limit even there (it is fixed by "
                 "the constraint), but the pressure (1/eps) (U_n - g)_+ is a quotient of "
                 "round-off: at C_eps = 1e-20 it is off by a factor ~2 (p = 1, n = 8, "
-                "tests/test_penalty_limits.py). err vs the limit 0.154398 saturates much "
+                "tests/contact/test_penalty_limits.py). err vs the limit 0.154398 saturates much "
                 f"earlier, at the n = 16 discretisation error {g.err.iloc[-1]:.2e}.")))
     return claims
 

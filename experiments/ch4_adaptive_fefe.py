@@ -47,9 +47,10 @@ from hpfebe.contact.two_body import TwoBodyContact
 from hpfebe.fem import (cell_diameter, distance_to_set, is_conforming, local_mesh_size,
                         new_vertices, refine_labelled, refinement_concentration)
 from hpfebe.fem.elasticity import ElasticBody, rectangle_mesh
-from hpfebe.materials import PLANES
-from hpfebe.params import FrictionalContactScene, from_config
-from hpfebe.results import ArtefactResult, Claim, beats_uniform_claim, progress
+from hpfebe.constitutive.materials import PLANES
+from hpfebe.scenes.materials import FrictionalContactScene
+from hpfebe.suite.params import from_config
+from hpfebe.suite.results import ArtefactResult, Claim, beats_uniform_claim, progress
 
 ARTEFACTS = ("figure_4_13", "figure_4_14", "figure_4_15", "figure_4_16")
 NUMBA = False    # FE/FE only: runs beside the job that compiles the numba kernels
@@ -336,7 +337,7 @@ def wider_reading_claim(prm: Params, meshes: list) -> Claim:
 def vtu_meshes(tag, pr, res, etas) -> dict:
     """{f"{tag}_{body}": meshio.Mesh} of both bodies with the displacement and the
     indicator (max over the elements at each vertex), for ArtefactResult.exports."""
-    from hpfebe.export import fe_vtu
+    from hpfebe.io.vtu import fe_vtu
 
     out = {}
     for name, body, u, eta in zip(BODIES, (pr.slave, pr.master),

@@ -48,9 +48,9 @@ from hpfebe.analysis.rates import aitken, fitted_rate
 from hpfebe.adaptivity import adapt
 from hpfebe.adaptivity import hp_refine, mortar_indicators
 from hpfebe.contact.mortar import contact_from_meshes, model_meshes, model_problem
-from hpfebe.materials import lame_constants
-from hpfebe.params import from_config
-from hpfebe.results import CELLS_PREFIX, ArtefactResult, Claim, progress, rate_claim
+from hpfebe.constitutive.materials import lame_constants
+from hpfebe.suite.params import from_config
+from hpfebe.suite.results import CELLS_PREFIX, ArtefactResult, Claim, progress, rate_claim
 
 ARTEFACTS = ("table_4_1", "figure_4_17", "figure_4_18", "figure_4_19", "figure_4_20",
              "figure_dtn_map", "figure_uzawa_rho", "figure_solver_comparison")
@@ -112,7 +112,7 @@ CHOICES = (
     "was hit in every Table 4.1 run).",
     "Warm starts: the Uzawa multiplier and the projected-CG iterate are carried from one "
     "DtN iteration to the next; P_1 = 0, Q_0 = 0 as in Algorithm 4.3.",
-    "Stopping rules from hpfebe.nonlinear.fixed_point: ||P_k+1 - P_k||_2 <= TOL "
+    "Stopping rules from hpfebe.solvers.nonlinear.fixed_point: ||P_k+1 - P_k||_2 <= TOL "
     "||P_k+1||_2 (the thesis divides by ||P_k||); Uzawa the same in lambda; projected CG "
     "to a projected gradient <= 1e-11 max(||b||, ||A x||). Non-convergence = the DtN cap "
     "max_dtn (a period-2 cycle is what we observe), growth by 1e6 or NaN.",

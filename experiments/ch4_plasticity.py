@@ -18,7 +18,7 @@ first), mesh bebe_h.
 Scenes (:data:`SCENES`, one workflow job each): ``ex1`` (figures 4.1-4.5) and ``ex2``
 (figures 4.6-4.12 with the locking study, BE/BE and its mesh study).
 
-Core: :mod:`hpfebe.fem.plasticity` (return map), :mod:`hpfebe.fem.plastic_body` (B-bar
+Core: :mod:`hpfebe.constitutive.j2` (return map), :mod:`hpfebe.fem.plastic_body` (B-bar
 Q1 work piece), :mod:`hpfebe.scenes.stamping` (touches through
 :class:`hpfebe.contact.two_body.TwoBodyContact`).  The choices where the thesis is silent
 are :data:`CHOICES`.
@@ -37,14 +37,14 @@ from matplotlib.collections import PolyCollection
 from matplotlib.figure import Figure
 
 from hpfebe.contact.loading import LU_ORDERINGS
-from hpfebe.export import fe_vtu
-from hpfebe.fem.plasticity import J2Material
+from hpfebe.io.vtu import fe_vtu
+from hpfebe.constitutive.j2 import J2Material
 from hpfebe.scenes import (ContactSettings, be_work_piece, curve_difference,
                            element_areas, field_difference, plastic_zone,
                            stamp_body, stamp_interior, touch, touch_be, work_piece,
                            zone_mismatch)
-from hpfebe.params import from_config
-from hpfebe.results import ArtefactResult, Claim, progress
+from hpfebe.suite.params import from_config
+from hpfebe.suite.results import ArtefactResult, Claim, progress
 
 ARTEFACTS = ("figure_4_1", "figure_4_2", "figure_4_3", "figure_4_4", "figure_4_5",
              "figure_4_6", "figure_4_7", "figure_4_8", "figure_4_9", "figure_4_10",

@@ -56,9 +56,9 @@ from matplotlib.figure import Figure
 from hpfebe.scenes import ContactSettings, stamp_body, stamp_interior, touch
 from hpfebe.fem.elasticity import rectangle_mesh
 from hpfebe.fem.plastic_body import ElastoPlasticFE
-from hpfebe.fem.plasticity import SQ23, J2Material
-from hpfebe.params import from_config
-from hpfebe.results import ArtefactResult, Claim, range_claim, rate_claim, progress
+from hpfebe.constitutive.j2 import SQ23, J2Material
+from hpfebe.suite.params import from_config
+from hpfebe.suite.results import ArtefactResult, Claim, range_claim, rate_claim, progress
 
 ARTEFACTS = ("table_4_3", "figure_4_22", "table_4_2", "figure_4_21")
 #: independent computations: Table 4.3's penalty sweeps (both contact treatments, the

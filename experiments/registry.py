@@ -6,7 +6,9 @@ that fails to import (work in progress, missing dependency) still gets its rule 
 only when it runs.  Standard library only.
 
 A file is an experiment module if it is not private (``_*.py``), is not this file, and
-assigns a tuple of string literals to ``ARTEFACTS`` at module level.  Other files
+assigns a tuple of string literals to ``ARTEFACTS`` at module level.  An experiment may
+also be a package, ``experiments/<name>/__init__.py`` (scene, claims and figures in
+modules beside it): its ``__init__.py`` holds ``ARTEFACTS``, ``SCENES`` and ``run``.  Other files
 (helpers shared by experiments) are ignored.  A module that calls no numba kernel says so
 with ``NUMBA = False`` (a literal; default True): the workflow runs it beside the job that
 compiles the kernels instead of after it.
@@ -18,9 +20,9 @@ scenes asked for.  Every scene is one workflow job (:attr:`Job.rule`: the module
 a module without SCENES, ``<module>__<scene>`` otherwise), so that asking for one
 artefact computes only its scene and independent scenes run on different cores.
 
-The workflow inputs of a job are its module file and the ``experiments/`` files it
-imports (``from experiments.X import ...`` / ``import experiments.X``, followed through
-those files): :attr:`Experiment.sources`.
+The workflow inputs of a job are its module file (every file of a package) and the
+``experiments/`` files it imports (``from experiments.X import ...`` / ``import
+experiments.X``, followed through those files): :attr:`Experiment.sources`.
 """
 
 from __future__ import annotations
@@ -210,35 +212,50 @@ def _scenes_of(path: Path, assigned: dict[str, ast.expr], artefacts: tuple[str, 
     return tuple(out)
 
 
+def _module_files(name: str, directory: Path) -> tuple[Path, ...]:
+    """The files of the experiments/ module ``name``: ``name.py``, or every file of the
+    package ``name/``; () if there is neither."""
+    if (directory / f"{name}.py").is_file():
+        return (directory / f"{name}.py",)
+    if (directory / name / "__init__.py").is_file():
+        return tuple(sorted((directory / name).rglob("*.py")))
+    return ()
+
+
 def _imported_experiments(path: Path, directory: Path) -> set[str]:
     """Names of the ``experiments/`` modules that ``path`` imports (at any level)."""
     tree = ast.parse(path.read_text(encoding="utf-8"), filename=str(path))
+    depth = len(path.relative_to(directory).parts) - 1    # 0: experiments/x.py
     names = set()
     for node in ast.walk(tree):
         mods = []
-        if isinstance(node, ast.ImportFrom) and node.module:
-            if node.level == 0 and node.module.startswith("experiments."):
+        if isinstance(node, ast.ImportFrom):
+            if node.level == 0 and node.module and node.module.startswith("experiments."):
                 mods.append(node.module.split(".")[1])
             elif node.level == 0 and node.module == "experiments":
                 mods += [a.name for a in node.names]
-            elif node.level == 1:
-                mods.append(node.module.split(".")[0])
+            elif node.level == depth + 1:           # relative to experiments/ itself
+                mods += ([node.module.split(".")[0]] if node.module
+                         else [a.name for a in node.names])
         elif isinstance(node, ast.Import):
             mods += [a.name.split(".")[1] for a in node.names
                      if a.name.startswith("experiments.")]
-        names.update(m for m in mods if (directory / f"{m}.py").is_file())
+        names.update(m for m in mods if _module_files(m, directory))
     return names
 
 
-def _sources(path: Path, directory: Path) -> tuple[Path, ...]:
-    """``path`` and every experiments/ file it imports, transitively (sorted)."""
-    seen, todo = {path.stem}, [path.stem]
+def _sources(name: str, directory: Path) -> tuple[Path, ...]:
+    """The files of module ``name`` and of every experiments/ module they import,
+    transitively: the module's own files first, the imported ones sorted."""
+    own = _module_files(name, directory)
+    seen, todo = {name}, [name]
     while todo:
-        for m in _imported_experiments(directory / f"{todo.pop()}.py", directory):
-            if m not in seen:
-                seen.add(m)
-                todo.append(m)
-    return (path, *sorted(directory / f"{m}.py" for m in seen - {path.stem}))
+        for f in _module_files(todo.pop(), directory):
+            for m in _imported_experiments(f, directory):
+                if m not in seen:
+                    seen.add(m)
+                    todo.append(m)
+    return (*own, *sorted(f for m in seen - {name} for f in _module_files(m, directory)))
 
 
 def unknown_sections(config: dict, modules) -> list[tuple[str, str | None]]:
@@ -264,8 +281,10 @@ def discover(directory: Path | str | None = None) -> Registry:
         raise FileNotFoundError(f"experiments directory not found: {directory}")
     found: list[Experiment] = []
     owner: dict[str, str] = {}
-    for path in sorted(directory.glob("*.py")):
-        name = path.stem
+    candidates = [*directory.glob("*.py"), *directory.glob("*/__init__.py")]
+    for path in sorted(candidates, key=lambda p: (p.parent.name if p.name == "__init__.py"
+                                                 else p.stem)):
+        name = path.parent.name if path.name == "__init__.py" else path.stem
         if name.startswith("_") or name == "registry":
             continue
         assigned = _assignments(path)
@@ -279,10 +298,10 @@ def discover(directory: Path | str | None = None) -> Registry:
         for a in arts:
             if a in owner:
                 raise ValueError(f"artefact {a!r} is claimed by both experiments/"
-                                 f"{owner[a]}.py and experiments/{name}.py")
+                                 f"{owner[a]} and experiments/{name}")
             owner[a] = name
         found.append(Experiment(name=name, path=path, artefacts=arts,
                                 numba=_numba_flag(path, assigned),
                                 scenes=_scenes_of(path, assigned, arts),
-                                sources=_sources(path, directory)))
+                                sources=_sources(name, directory)))
     return Registry(tuple(found))

@@ -21,6 +21,6 @@ if not any(v in os.environ for v in _VARS):
 import sys  # noqa: E402
 from pathlib import Path  # noqa: E402
 
-_ROOT = str(Path(__file__).resolve().parents[1])
+_ROOT = str(Path(__file__).resolve().parents[2])
 if _ROOT not in sys.path:
     sys.path.insert(0, _ROOT)

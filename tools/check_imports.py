@@ -11,7 +11,7 @@ printed with one shortest cycle through it and the file:line of every edge on it
 
     python tools/check_imports.py                 # exit 1 if any cycle, else 0
     python tools/check_imports.py --graph         # also print every edge
-    python tools/check_imports.py --experiments   # deep imports of experiments/*.py
+    python tools/check_imports.py --experiments   # deep imports in experiments/
 
 ``--experiments`` lists each ``from hpfebe.<...> import name`` of experiments/*.py whose
 name is not in the ``__all__`` of ``hpfebe`` or of a top-level subpackage's ``__init__``
@@ -161,7 +161,8 @@ def shortest_cycle(start: str, comp: set[str], succ) -> list[str]:
     return []
 
 
-def check_cycles(show_graph: bool = False) -> int:
+def check_cycles(show_graph: bool = False, quiet: bool = False) -> int:
+    """Number of import cycles (strongly connected sets of units); printed unless quiet."""
     e = edges()
     succ = defaultdict(set)
     nodes = set()
@@ -172,6 +173,8 @@ def check_cycles(show_graph: bool = False) -> int:
         for (a, b), where in sorted(e.items()):
             print(f"{a} -> {b}: {', '.join(where)}")
     comps = strongly_connected(nodes, succ)
+    if quiet:
+        return len(comps)
     if not comps:
         print(f"no import cycle between the {len(top_units())} units of hpfebe "
               f"({len(e)} unit edges)")
@@ -190,7 +193,7 @@ def check_cycles(show_graph: bool = False) -> int:
             print("  " + " -> ".join(cyc))
             for a, b in zip(cyc, cyc[1:]):
                 print(f"    {a} -> {b}: {', '.join(e[(a, b)])}")
-    return 1
+    return len(comps)
 
 
 def public_names() -> dict[str, set[str]]:
@@ -202,14 +205,20 @@ def public_names() -> dict[str, set[str]]:
     return {n: set(getattr(importlib.import_module(n), "__all__", ())) for n in names}
 
 
-def check_experiments(strict: bool = False) -> int:
+def deep_imports() -> list[str]:
+    """Each import of a non-public hpfebe name in experiments/ (packages included), as
+    'file:line: from ... import name  (public: ...)'."""
+    return _deep_imports()[0]
+
+
+def _deep_imports():
     public = public_names()
     where = {}                                   # public name -> the facades exporting it
     for mod, names in public.items():
         for n in names:
             where.setdefault(n, []).append(mod)
     deep, by_module = [], defaultdict(int)
-    for path in sorted((ROOT / "experiments").glob("*.py")):
+    for path in sorted((ROOT / "experiments").rglob("*.py")):
         rel = path.relative_to(ROOT)
         for node in ast.walk(ast.parse(path.read_text(), filename=str(path))):
             if isinstance(node, ast.ImportFrom) and node.level == 0 and node.module \
@@ -227,6 +236,11 @@ def check_experiments(strict: bool = False) -> int:
                     if a.name.split(".")[0] == PKG_NAME and a.name not in public:
                         deep.append(f"{rel}:{node.lineno}: import {a.name}")
                         by_module[a.name] += 1
+    return deep, by_module
+
+
+def check_experiments(strict: bool = False) -> int:
+    deep, by_module = _deep_imports()
     for d in deep:
         print(d)
     print("deep imports by module: " + ", ".join(
@@ -247,7 +261,7 @@ def main(argv=None) -> int:
     args = ap.parse_args(argv)
     if args.experiments:
         return check_experiments(args.strict)
-    return check_cycles(args.graph)
+    return 1 if check_cycles(args.graph) else 0
 
 
 if __name__ == "__main__":

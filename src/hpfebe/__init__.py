@@ -33,12 +33,12 @@ _API = {
     "ContinuousSpace": "spaces", "DiscontinuousSpace": "spaces",
     "LaplaceBEM": "bem", "LameBEM": "bem",
     "PoissonFE": "fem", "ElasticBody": "fem", "ElastoPlasticFE": "fem",
-    "lame_constants": "materials", "J2Material": "fem", "penalty_friction": "constitutive",
+    "lame_constants": "constitutive", "J2Material": "constitutive", "penalty_friction": "constitutive",
     "FEBody": "bodies", "PlasticFEBody": "bodies", "BEBody": "bodies",
     "ElastoPlasticBE": "bodies", "PlasticBEBody": "bodies", "RigidObstacle": "bodies",
     "NitscheFEBE": "coupling", "TwoBodyContact": "contact", "MortarContact": "contact",
     "FEMortarContact": "contact", "solve_penalty": "contact", "solve_friction": "contact",
-    "newton": "nonlinear", "load_path": "nonlinear", "SolverInfo": "nonlinear",
+    "newton": "solvers", "load_path": "solvers", "SolverInfo": "solvers",
     "adapt": "adaptivity",
 }
 

@@ -18,7 +18,7 @@ import sys
 import time
 from pathlib import Path
 
-from .results import published_file_for
+from .suite.results import published_file_for
 
 log = logging.getLogger("hpfebe")
 
@@ -117,7 +117,7 @@ class Terminated(BaseException):
 
 
 def _on_signal(signum, frame):  # noqa: ARG001 - signal handler signature
-    from .results import remove_temporaries
+    from .suite.results import remove_temporaries
 
     remove_temporaries()
     raise Terminated(signum)
@@ -127,7 +127,7 @@ def install_signal_handlers() -> None:
     """SIGTERM and SIGHUP end a run like Ctrl-C does: the temporary files of atomic
     writes in progress are removed, no result file is left half written, and the exit
     status is 128 + signal number.  (SIGINT raises KeyboardInterrupt, which
-    :func:`hpfebe.results.atomic_write` cleans up the same way; exit 130.)"""
+    :func:`hpfebe.suite.results.atomic_write` cleans up the same way; exit 130.)"""
     for sig in (signal.SIGTERM, getattr(signal, "SIGHUP", None)):
         if sig is not None:
             signal.signal(sig, _on_signal)
@@ -168,7 +168,7 @@ def _stop_when(gone, why: str, interval: float, grace: float):
         log.warning("%s: stopping this run", why)
         os.kill(os.getpid(), signal.SIGTERM)
         time.sleep(grace)
-        from .results import remove_temporaries
+        from .suite.results import remove_temporaries
 
         remove_temporaries()
         os._exit(128 + signal.SIGTERM)
@@ -506,7 +506,7 @@ def cmd_run(args) -> int:
 
     matplotlib.use("Agg", force=True)  # figures are plain Figure objects (no pyplot)
 
-    from . import results as res
+    from .suite import results as res
 
     module = importlib.import_module(exp.module)
     arts = tuple(getattr(module, "ARTEFACTS", ()))
@@ -515,7 +515,7 @@ def cmd_run(args) -> int:
                        f"literal read by the registry ({exp.artefacts})")
     if not callable(getattr(module, "run", None)):
         raise CLIError(f"{exp.path} has no function run(config, quick=False)")
-    from .params import ConfigError
+    from .suite.params import ConfigError
 
     for job in jobs:
         remove_stale_temporaries(out, job.artefacts)
@@ -565,7 +565,7 @@ def cmd_run(args) -> int:
 
 def cmd_report(args) -> int:
     root = find_root()
-    from .report import build_report
+    from .suite.report import build_report
 
     results_dir = Path(args.results) if args.results else root / "results"
     out = Path(args.out) if args.out else root / "report"
@@ -585,8 +585,8 @@ def cmd_report(args) -> int:
 def cmd_compile(args) -> int:
     """Compile (or load from numba's cache) every numba kernel once; with --stamp FILE,
     record the times in FILE (JSON, written atomically: the workflow's numba_cache rule)."""
-    from .results import atomic_write
-    from .warmup import compile_kernels
+    from .suite.results import atomic_write
+    from .suite.warmup import compile_kernels
 
     with JitTimer() as jit:
         t0 = time.perf_counter()
@@ -669,7 +669,7 @@ def main(argv: list[str] | None = None) -> int:
         print(f"hpfebe: error: {exc}", file=sys.stderr)
         return EXIT_USAGE
     except KeyboardInterrupt:
-        from .results import remove_temporaries
+        from .suite.results import remove_temporaries
 
         remove_temporaries()
         print("hpfebe: interrupted (no result file was left half written)", file=sys.stderr)

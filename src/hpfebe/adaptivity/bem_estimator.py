@@ -42,7 +42,7 @@ principal value on the element of x, adaptive Gauss on the others), U' = dU/ds i
     S_hat U = W U + (K' + 1/2) Psi      = - g[U'] . t + g[Psi] . n + Psi / 2,
     d/ds (V Psi - (K + 1/2) U)          =   g[Psi] . t + g[U'] . n - U' / 2.
 
-Both identities are checked to round-off in tests/test_adaptivity.py (Calderon: W u =
+Both identities are checked to round-off in tests/adaptivity/test_adaptivity.py (Calderon: W u =
 (1/2 - K') psi for an exact harmonic pair).  The L2(I) norms use composite Gauss on a mesh
 of I graded geometrically towards both ends (the log singularities); against a rule with
 8 grading levels and 8 more points per interval the indicators change by < 0.4 %.
@@ -304,9 +304,9 @@ def contact_traction(op, U, gap, eps_n: float, eps_t: float, mu_f=None, F=None, 
 def consistency_weight(variant: str, E: float, nu: float, plane: str = "strain") -> float:
     """Weight of the consistency term h_I ||d/ds (V Psi - (K + 1/2) U)||^2 of (3.107) for
     Lame: "literal" 1 (the thesis's formula, a strain beside a traction), "balanced"
-    E' (:func:`hpfebe.materials.plane_modulus`), which gives both terms the units of
+    E' (:func:`hpfebe.constitutive.materials.plane_modulus`), which gives both terms the units of
     (traction x length)^2."""
-    from ..materials import plane_modulus
+    from ..constitutive.materials import plane_modulus
 
     if variant == "literal":
         return 1.0

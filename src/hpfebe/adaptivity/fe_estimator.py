@@ -32,7 +32,7 @@ from skfem import Basis, ElementQuad1, ElementTriP1, FacetBasis, Functional, Int
 from skfem.helpers import grad
 
 from ..fem.meshes import cell_diameter, facet_containing
-from ..materials import lame_constants, linear_stress
+from ..constitutive.materials import lame_constants, linear_stress
 
 
 def _facet_length(mesh, facets) -> np.ndarray:

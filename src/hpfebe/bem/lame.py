@@ -33,7 +33,7 @@ Problems", Springer 2008, chapter on linear elastostatics, for the 3D analogue):
     E'       = 4 mu (lambda + mu) / (lambda + 2 mu)   (= E / (1 - nu^2) in plane strain),
 
 i.e. 4 mu^2 times the fundamental solution with (3 - 4 nu) replaced by 1.  How the two
-coefficients are pinned down (and checked in tests/test_lame.py): the log coefficient by
+coefficients are pinned down (and checked in tests/bem/test_lame.py): the log coefficient by
 the symbol of W on a straight line (E'|xi|/4, half the symbol of the half-plane
 Dirichlet-to-Neumann map); the r r^T coefficient by the rigid rotation, whose tangential
 derivative is -n and which must lie in ker W (it does to 1e-15 only with this
@@ -47,7 +47,7 @@ On meshes with all degrees 1, V, Vt and K have closed forms (:mod:`hpfebe.bem.lo
 formulas (Q1), (Q2), (L1), (L2): K by the Guenter-derivative representation
 K = K_Laplace I + (V_Laplace I - 2 mu V)(I J) T, J = [[0, 1], [-1, 0]]), used unless
 ``closed_form=False``; the general quadrature path of :func:`assemble` is the reference
-(they agree to 1e-13 of the largest entry, tests/test_bem_lowest_order_lame.py).
+(they agree to 1e-13 of the largest entry, tests/bem/test_bem_lowest_order_lame.py).
 
 Vector functions are interleaved: global index = 2 * scalar dof + component.
 
@@ -71,7 +71,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..geometry import BoundaryMesh
-from ..materials import PLANES, lame_constants, linear_stress  # noqa: F401  (re-exported)
+from ..constitutive.materials import PLANES, lame_constants, linear_stress  # noqa: F401  (re-exported)
 from ..spaces import ContinuousSpace, DiscontinuousSpace
 from .assembly import assemble, local_block, sandwich
 from .kernels import (KP_C1, KP_C1_C2, KP_C1_LOG_R, KP_C2, KP_ET, KP_ET_LOG_R, KP_LAMBDA,

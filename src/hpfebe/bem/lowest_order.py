@@ -65,7 +65,7 @@ truncated at total degree m + j <= n.  The tail is bounded by sum_{k>n} E[(|alph
 single layer's terms have an extra 1/k), so n is the least order with that bound below
 SERIES_TOL: no logarithm but log|w_m|, and no cancellation (all terms decrease).
 
-Accuracy against the general quadrature path (tests/test_bem_lowest_order.py): at most
+Accuracy against the general quadrature path (tests/bem/test_bem_lowest_order.py): at most
 4.3e-15 of the largest entry on squares (N = 16 ... 256), an L-shape, slits of width
 1e-2 ... 1e-8, a 3 degree wedge, a star and a 12 times graded mesh.  On smooth curves
 (curvature radius rho) the K entries of neighbours are ~ L / rho smaller than L_i L_j /
@@ -109,7 +109,7 @@ odd), s1' = sum c1_jm a^m b^j (m odd, j even) that give J0, J1, J1',
     Q = L_i L_j (w_m / wb_m) [conj(s0) + a conj(s1') + b conj(s1)],                    (Q2)
 
 whose tail is (1 + q) times that of the double layer's series (the same order n).
-Measured (tests/test_bem_lowest_order_lame.py): (Q1) against (Q2) within 5.8e-15, 1.1e-14,
+Measured (tests/bem/test_bem_lowest_order_lame.py): (Q1) against (Q2) within 5.8e-15, 1.1e-14,
 2.4e-14 of L_i L_j at q = 0.225, 0.125, 0.05; (Q1) against a 200-point Gauss rule for
 adjacent pairs at 30 ... 150 degrees.
 

@@ -2,7 +2,7 @@
 Algorithm 4.2): boundary displacement unknowns with the discrete Steklov-Poincare operator
 S_hat of :class:`hpfebe.bem.lame.LameBEM`, the plastic strain piecewise constant on cells
 of the work piece (:class:`hpfebe.fem.newton_potential.CellComplex`), updated from the
-cell-average strain by the J2 return map (:mod:`hpfebe.fem.plasticity`).
+cell-average strain by the J2 return map (:mod:`hpfebe.constitutive.j2`).
 
 A body of :mod:`hpfebe.bodies`, below the contact problems: it needs the boundary
 operators, the Newton potential of :mod:`hpfebe.fem.newton_potential` and the J2 return
@@ -47,19 +47,19 @@ returns (S_hat u - G tau(eps_p committed), S_hat): a pure function of u and the 
 history (the body protocol of :mod:`hpfebe.bodies.body`), and ``commit(u)`` performs
 the return map per cell (cell-average strain) from the committed state with the strain at u -
 the plastic strain is one load step behind (explicit), so the result depends on the step
-size (tests/test_plastic_be.py measures it).  ``staggered_step`` iterates the update
+size (tests/bodies/test_plastic_be.py measures it).  ``staggered_step`` iterates the update
 within one load step (Algorithm 4.2 step v with eps_p^(k) in b, the fixed point of
-:func:`hpfebe.nonlinear.fixed_point`) - it converges to the implicit solution, linearly
+:func:`hpfebe.solvers.nonlinear.fixed_point`) - it converges to the implicit solution, linearly
 with a rate near 1 - 2 mu / (2 mu + 2/3 H) ... (slow for small hardening).
 
 **Near-perfect plasticity (the thesis material of Section 4.4: E / sigma_Y = 66700,
-H = 450).**  Two things matter, both measured (notes in tests/test_plastic_be.py):
+H = 450).**  Two things matter, both measured (notes in tests/bodies/test_plastic_be.py):
 
 * the forward Euler update is first order in the step and stiff by the elastic predictor:
   a lift increment of 4.2e-4 is ~30 yield strains; the Example 2 stamp reaction is 352
   with 10 increments, 125 with 40, against 24.8 with backward Euler (h = 0.4).  The
   figures therefore use ``scheme="implicit"``: the backward Euler cell strains at u,
-  F(e) = e - B u - M tau(RM(e)) = 0, solved by :func:`hpfebe.nonlinear.newton` with
+  F(e) = e - B u - M tau(RM(e)) = 0, solved by :func:`hpfebe.solvers.nonlinear.newton` with
   Armijo line search and the Jacobian reduced to the plastic cells
   (:class:`_CellStrainProblem`), and the consistent tangent for the contact Newton;
 * constant plastic strain on axis-parallel squares locks under isochoric flow (its
@@ -82,8 +82,8 @@ from ..geometry import BoundaryMesh
 from ..fem.newton_potential import (CellComplex, edge_integrals, initial_stress,
                                    kelvin_constants, newton_operators)
 from .body import BEBody
-from ..fem.plasticity import J2Material, J2State, embed_plane, return_map, tensor_norm, dev
-from ..nonlinear import Iterate, LineSearch, SingularStep, fixed_point, newton
+from ..constitutive.j2 import J2Material, J2State, embed_plane, return_map, tensor_norm, dev
+from ..solvers import Iterate, LineSearch, SingularStep, fixed_point, newton
 
 GAUSS_EDGE = 4
 SCHEMES = ("explicit", "implicit")
@@ -396,7 +396,7 @@ class ElastoPlasticBE:
     def implicit_response(self, u: np.ndarray, tol: float = 1e-10, max_iter: int = 50):
         """Backward Euler plastic state at u: the cell strains e solve
         F(e) = e - B u - M tau(RM(e)) = 0 (RM the return map from the committed history,
-        tau its initial stress), by :func:`hpfebe.nonlinear.newton` with Armijo line search
+        tau its initial stress), by :func:`hpfebe.solvers.nonlinear.newton` with Armijo line search
         on ||F||^2 (semismooth: the plastic set changes between iterates).  Its Jacobian
         I - M D (D = d tau / d e = (C - C_alg) in-plane, zero on elastic cells) is reduced
         to the plastic cells: (I - M_pp D_p) de_p = -F_p, de_e = -F_e + M_ep D_p de_p.
@@ -456,7 +456,7 @@ class ElastoPlasticBE:
         """Algorithm 4.2 within one load step: u^(k+1) = solve(G(eps_p^(k))) (the
         elastic solve with the plastic force on the right-hand side, a callable
         returning u), eps_p^(k+1) from the return map at u^(k+1); fixed point of
-        :func:`hpfebe.nonlinear.fixed_point` on eps_p.  Commits the converged state and
+        :func:`hpfebe.solvers.nonlinear.fixed_point` on eps_p.  Commits the converged state and
         returns (u, SolverInfo)."""
         state = {}
 
@@ -483,7 +483,7 @@ class ElastoPlasticBE:
 
 class _CellStrainProblem:
     """The inner problem of :meth:`ElastoPlasticBE.implicit_response` for
-    :func:`hpfebe.nonlinear.newton`: x = cell strains e (3 ncell), residual
+    :func:`hpfebe.solvers.nonlinear.newton`: x = cell strains e (3 ncell), residual
     F(e) = e - b - M tau(RM(e)), merit ||F||^2 / 2, key = the plastic set; the scale of
     the stopping test is max|e| + the yield strain sigma_Y / E (sigma_Y capped at 1e-3 E,
     :attr:`J2Material.stress_floor`)."""

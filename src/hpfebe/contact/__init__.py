@@ -4,7 +4,7 @@ Tresca / Coulomb friction (:func:`solve_friction`, Sections 3.3.1, 4.2), normal 
 contact with exact integration of the positive part (:func:`solve_penalty`, Section 3.2),
 and mortar contact of two BE bodies (:class:`MortarContact`, Section 4.3) or of FE bodies
 (:class:`FEMortarContact`, Section 4.4).  The bodies: :mod:`hpfebe.bodies`; the pointwise
-laws: :mod:`hpfebe.constitutive`; Newton and the load path: :mod:`hpfebe.nonlinear`."""
+laws: :mod:`hpfebe.constitutive`; Newton and the load path: :mod:`hpfebe.solvers.nonlinear`."""
 
 from .friction import FrictionResult, solve_friction
 from .loading import LoadSteps

@@ -18,7 +18,7 @@ Gamma_C; the contact state (pressure, stick/slip, slip history) lives at these p
 so the residual is piecewise linear in U and the Newton matrix its exact generalised
 derivative.
 
-Newton (:func:`hpfebe.nonlinear.newton` in the load path of Algorithm 4.1, load factor
+Newton (:func:`hpfebe.solvers.nonlinear.newton` in the load path of Algorithm 4.1, load factor
 lambda_j = j / N scaling the load and the obstacle motion; the gap is geometry):
 backtracking line search on the energy (Tresca; the equation is its gradient) or on
 ||R||_2 (Coulomb, no potential); max-norm residual, stopping when

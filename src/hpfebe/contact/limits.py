@@ -40,7 +40,7 @@ from scipy.optimize import brentq
 
 from ..bem.lame import LameBEM
 from ..geometry import BoundaryMesh
-from ..materials import lame_constants
+from ..constitutive.materials import lame_constants
 from .penalty import PenaltyResult, penalty_residual, solve_penalty
 
 __all__ = ["MACHEPS", "SQUARE", "SQUARE_LABELS", "PenaltyCheck", "backward_error",

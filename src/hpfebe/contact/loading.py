@@ -2,8 +2,8 @@
 at each load factor the Newton problem (residual R = f_int(U) + f_c(U) - F_ext on the free
 dofs, its merit, force scale and contact pattern), its start (the last converged state
 with the new Dirichlet values), the commit of the slip and of the bodies' history after
-convergence (the :class:`hpfebe.nonlinear.LoadStep` and
-:class:`hpfebe.nonlinear.NewtonProblem` protocols), and the bonded predictor."""
+convergence (the :class:`hpfebe.solvers.nonlinear.LoadStep` and
+:class:`hpfebe.solvers.nonlinear.NewtonProblem` protocols), and the bonded predictor."""
 
 from __future__ import annotations
 
@@ -15,7 +15,7 @@ import scipy.linalg as sla
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from ..nonlinear import Iterate, SingularStep, SolverInfo
+from ..solvers import Iterate, SingularStep, SolverInfo
 from ..constitutive.laws import STATE_NAMES, updated_slip
 
 MERITS = ("residual", "energy")
@@ -29,7 +29,7 @@ LU_ORDERINGS = ("COLAMD", "MMD_AT_PLUS_A")
 class LoadSteps:
     """The load steps of :meth:`TwoBodyContact.solve`: the Newton problem at a load
     factor (residual R = K U + f_c(U) - F_ext on the free dofs), its start, and the
-    commit of the slip after a converged step (:class:`hpfebe.nonlinear.LoadStep`)."""
+    commit of the slip after a converged step (:class:`hpfebe.solvers.nonlinear.LoadStep`)."""
 
     #: factorisations of the sparse Newton matrix kept for reuse (:meth:`_factor`): at
     #: most this many, and at most LU_CACHE_NNZ nonzeros in their factors together

@@ -22,9 +22,9 @@ integrated by the Gauss-Lobatto rule of each element (weights w_j, lumped), so t
 the Tresca conditions hold pointwise at these points: |lambda_j| <= 1 and
 lambda_j (U_t - Q_t)_j = |(U_t - Q_t)_j|.
 
-Every outer loop is :func:`hpfebe.nonlinear.fixed_point` (stopping rule
+Every outer loop is :func:`hpfebe.solvers.nonlinear.fixed_point` (stopping rule
 ||x_k - x_{k-1}|| <= TOL ||x_k||, divergence and iteration cap detected there); the inner
-solves report a :class:`~hpfebe.nonlinear.SolverInfo` collected in ``info.steps``.
+solves report a :class:`~hpfebe.solvers.nonlinear.SolverInfo` collected in ``info.steps``.
 """
 
 from __future__ import annotations
@@ -38,7 +38,7 @@ from numba import njit
 from ..bem.lame import LameBEM
 from ..coupling.mortar import MortarProjection
 from ..geometry import BoundaryMesh
-from ..nonlinear import SingularStep, SolverInfo, fixed_point
+from ..solvers import SingularStep, SolverInfo, fixed_point
 from ..quadrature import gauss_lobatto
 
 
@@ -797,9 +797,9 @@ class MortarContact:
             P_n - max(0, z_n) = 0,   P_t - clip(z_t, -b, b) = 0,
             z_n = P_n + c (d_n - g),  z_t = P_t + c d_t,  b = mu_f max(0, z_n) or F,
 
-        with c = rho_crit / 2, by :func:`hpfebe.nonlinear.newton` (line search on
+        with c = rho_crit / 2, by :func:`hpfebe.solvers.nonlinear.newton` (line search on
         1/2 |F|^2, cycling detection on the active/stick pattern)."""
-        from ..nonlinear import Iterate, newton
+        from ..solvers import Iterate, newton
 
         if friction not in ("coulomb", "tresca"):
             raise ValueError(f"friction must be 'coulomb' or 'tresca', got {friction!r}")

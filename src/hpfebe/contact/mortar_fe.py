@@ -21,7 +21,7 @@ elastoplastic one (Remark 4.3.5: the nonlinearities are separated),
     f_int(U^2_k) = -P_k on Gamma^2_C,   U^2_k = u_D on Gamma^2_D,                   (4.88)
 
 one backward-Euler step (4.38)-(4.43) from the committed (virgin) history of the work
-piece, solved by :func:`hpfebe.nonlinear.newton` on the body's
+piece, solved by :func:`hpfebe.solvers.nonlinear.newton` on the body's
 :class:`~hpfebe.fem.plastic_body.DisplacementSteps` problem (consistent tangent,
 Armijo line search; each Newton system by the banded Cholesky factorisation of the
 symmetric positive definite tangent, :class:`_BandSteps`, 15-18x faster than SuperLU on the
@@ -46,9 +46,9 @@ from scipy.linalg import lapack
 from ..coupling.mortar import MortarProjection
 from ..fem.elasticity import ElasticBody
 from ..fem.plastic_body import DisplacementSteps, ElastoPlasticFE
-from ..fem.plasticity import dev, tensor_norm
+from ..constitutive.j2 import dev, tensor_norm
 from ..geometry import BoundaryMesh
-from ..nonlinear import Iterate, SingularStep, SolverInfo, fixed_point, newton
+from ..solvers import Iterate, SingularStep, SolverInfo, fixed_point, newton
 from ..spaces import ContinuousSpace
 from .mortar import (CondensedBody, MortarContact, MortarSolution, _check_omega,
                      _check_pos, ray_gap)
@@ -61,7 +61,7 @@ SIDES = ("bottom", "right", "top", "left")
 #: Gamma^2_C; U2: the work piece's displacement of step 2), the norm (l2 / max of the
 #: coefficient vector, L2(Gamma_C) of the function M2^-1 P, the elastic energy norm of
 #: U2, U2 on Gamma^2_C) and the reference (the previous iterate - the printed rule -, the
-#: new one - :func:`hpfebe.nonlinear.fixed_point`'s -, or the first nonzero P).
+#: new one - :func:`hpfebe.solvers.nonlinear.fixed_point`'s -, or the first nonzero P).
 #: "P_n_l2_prev": the normal components of P alone (a test on the contact pressure).
 #: "P_t_l2_prev" is no reading but a bound: the tangential components of P's increment
 #: alone, relative to ||P^k-1|| (<= P_l2_prev: the printed rule cannot stop before it
@@ -505,7 +505,7 @@ class FEMortarContact(MortarContact):
     def monolithic(self, tol: float = 1e-10, max_iter: int = 60,
                    c: float | None = None) -> MortarSolution:
         """(Beyond the thesis) the discrete problem of :meth:`dtn` solved at once by a
-        semismooth Newton method (:func:`hpfebe.nonlinear.newton`, line search on
+        semismooth Newton method (:func:`hpfebe.solvers.nonlinear.newton`, line search on
         1/2 |F|^2).  Unknowns: the stamp's contact values u1 (condensed), the work
         piece's free dofs u2 and the nodal contact forces y = (y_n, y_t) on body 1 in
         the node frames (force on body 1 = -R^T y, on body 2 = +pi^T R^T y):
@@ -629,7 +629,7 @@ def section44_scene(stamp_cells=(10, 20), work_cells=(61, 31), E: float = 266926
     work piece [-2, 2] x [-2, 0] (``work_cells``) whose bottom is displaced by
     (0, ``lift``); plane strain, Tresca friction F on the stamp's bottom."""
     from ..fem.elasticity import rectangle_mesh
-    from ..fem.plasticity import J2Material
+    from ..constitutive.j2 import J2Material
 
     for name, cells in (("stamp_cells", stamp_cells), ("work_cells", work_cells)):
         if len(cells) != 2 or any(int(k) != k or k < 1 for k in cells):

@@ -32,7 +32,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..nonlinear import SolverInfo
+from ..solvers import SolverInfo
 from ..bodies.body import RigidObstacle, against_obstacle
 from ..constitutive.laws import positive
 from .two_body import TwoBodyContact

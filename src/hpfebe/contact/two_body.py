@@ -94,7 +94,7 @@ Gauss points of the slave's contact elements, n_m = -n (n the slave's outward no
 t_m its tangent, g_n = g(x) - U_n, g_t = U_t - w(x): the one-body problems of Sections
 3.2-3.3 (:func:`hpfebe.contact.friction.solve_friction`).
 
-Algorithm 4.1 (:meth:`TwoBodyContact.solve` on :func:`hpfebe.nonlinear.load_path`): for
+Algorithm 4.1 (:meth:`TwoBodyContact.solve` on :func:`hpfebe.solvers.nonlinear.load_path`): for
 every load factor the load, the Dirichlet values and the obstacle motion are applied, the
 start iterate is the last converged state, semismooth Newton iterates (optionally with an
 Armijo line search on ||R||_2 or on the energy of a potential law; the semismooth
@@ -113,7 +113,7 @@ import numpy as np
 import scipy.linalg as sla
 import scipy.sparse as sp
 
-from ..nonlinear import Iterate, LineSearch, SolverInfo, load_path
+from ..solvers import Iterate, LineSearch, SolverInfo, load_path
 from ..quadrature import gauss_legendre
 from ..bodies.body import as_body, pointwise
 from ..constitutive.laws import OPEN, SLIP, STATE_NAMES, STICK  # noqa: F401  (re-exported)
@@ -666,7 +666,7 @@ class TwoBodyContact:
               initial: ContactResult | None = None,
               lu_ordering: str = "COLAMD", linear_solver: str = "lu") -> ContactResult:
         """Incremental loading with semismooth Newton (Algorithm 4.1,
-        :func:`hpfebe.nonlinear.load_path`).
+        :func:`hpfebe.solvers.nonlinear.load_path`).
 
         ``f_ext`` global load at load factor 1 (scaled by lambda) or a callable
         lambda -> vector; ``fixed_dofs`` with ``fixed_values`` (at lambda = 1, scaled;
@@ -678,7 +678,7 @@ class TwoBodyContact:
         the free dofs; not relative to R^(0), which grows like 1/eps and would accept
         wrong contact sets for stiff penalties);
         ``roundoff_stop``: a Newton update at round-off level ends the step, converged
-        only if the backward error is small (:func:`hpfebe.nonlinear.newton`).  ``line_search``: Armijo on
+        only if the backward error is small (:func:`hpfebe.solvers.nonlinear.newton`).  ``line_search``: Armijo on
         ``merit`` ("residual": ||R||_2, down to ``min_step``; "energy": the potential,
         for frictionless and Tresca contact, 30 halvings); cycling of the contact
         state is then detected.  ``predictor``: start each step from the bonded

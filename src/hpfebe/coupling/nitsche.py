@@ -53,7 +53,7 @@ import scipy.sparse.linalg as spla
 from ..bem import LaplaceBEM
 from ..fem.poisson import PoissonFE
 from ..quadrature import gauss_legendre
-from ..nonlinear import SolverInfo
+from ..solvers import SolverInfo
 from .examples import InterfaceProblem
 from .interface import interface_rule
 
@@ -68,7 +68,7 @@ DEFAULT_H_DEF = "edge"
 class NitscheSolution:
     """Solution of (2.3): U1 (FE, all dofs of ``fe``), U2 (BE, all dofs of ``V_space``),
     and diagnostics (``info``: residual, timings, sizes; ``solver``: the
-    :class:`hpfebe.nonlinear.SolverInfo` of the direct solve, residuals relative to the
+    :class:`hpfebe.solvers.nonlinear.SolverInfo` of the direct solve, residuals relative to the
     right-hand side)."""
 
     lambda_nit: float

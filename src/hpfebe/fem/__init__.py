@@ -1,5 +1,5 @@
 """Finite element parts (scikit-fem based): labelled meshes, Poisson Q_p, linear elasticity,
-the J2 plastic body with quadrature-point state, Newton potentials of plastic cells."""
+the J2 plastic body with quadrature-point state (the J2 law: :mod:`hpfebe.constitutive.j2`), Newton potentials of plastic cells."""
 
 from .meshes import (Concentration, FEDomain, block_grid, cell_diameter, distance_to_set,
                      facet_containing, is_conforming, local_mesh_size, new_vertices,
@@ -7,12 +7,10 @@ from .meshes import (Concentration, FEDomain, block_grid, cell_diameter, distanc
 from .elasticity import ElasticBody, rectangle_mesh
 from .newton_potential import CellComplex, newton_operators
 from .plastic_body import DisplacementSteps, ElastoPlasticFE
-from .plasticity import J2Material, J2State, consistent_tangent, return_map
 from .poisson import PoissonFE, quad_element
 
 __all__ = ["Concentration", "FEDomain", "block_grid", "cell_diameter", "distance_to_set",
            "facet_containing", "is_conforming", "local_mesh_size", "new_vertices",
            "refine_labelled", "refinement_concentration", "tensor_block_mesh", "PoissonFE",
            "quad_element", "ElasticBody", "rectangle_mesh", "CellComplex", "newton_operators",
-           "DisplacementSteps", "ElastoPlasticFE", "J2Material", "J2State",
-           "consistent_tangent", "return_map"]
+           "DisplacementSteps", "ElastoPlasticFE"]

@@ -2,7 +2,7 @@
 
 Lowest-order spaces of Section 4.2.3: R_1(K) = P_1 on triangles, Q_1 on quadrilaterals,
 vector valued.  Stiffness  a(u, v) = (sigma(u), eps(v)),  sigma = 2 mu eps + lambda tr(eps) I
-with (lambda, mu) from :func:`hpfebe.materials.lame_constants` (plane strain, or plane stress
+with (lambda, mu) from :func:`hpfebe.constitutive.materials.lame_constants` (plane strain, or plane stress
 with the modified lambda*).
 
 Dof numbering is scikit-fem's: ``basis.nodal_dofs[c, i]`` is component c (0 = x, 1 = y) at
@@ -32,7 +32,7 @@ from skfem import (
 )
 from skfem.models.elasticity import linear_elasticity
 
-from ..materials import lame_constants
+from ..constitutive.materials import lame_constants
 from .meshes import FEDomain
 
 KINDS = ("quad", "tri")

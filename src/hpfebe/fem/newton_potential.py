@@ -25,7 +25,7 @@ atan(u / eta) and rational terms), so the weakly singular integral (x on or near
 and the strongly singular one (eps(w) at points inside a cell, free term included) are
 exact up to round-off - no Duffy or polar splitting is needed.  The stress at a cell point
 x is sigma = C : (eps(u)(x) - eps_p(x)); the jump of eps(w) across edges is produced by the
-atan terms.  tests/test_newton_potential.py checks w and grad w against an independent
+atan terms.  tests/fem/test_newton_potential.py checks w and grad w against an independent
 polar (Duffy-type) cell quadrature with scipy and finite differences.
 
 The log-scale constant R of G drops out: every cell is closed, int_{d c} tau_c n ds = 0.
@@ -42,7 +42,7 @@ import math
 
 import numpy as np
 
-from ..materials import lame_constants
+from ..constitutive.materials import lame_constants
 
 TAU_COMPONENTS = 3
 

@@ -1,4 +1,4 @@
-"""An elastoplastic FE body (J2 flow theory, :mod:`hpfebe.fem.plasticity`) for Chapter 4's
+"""An elastoplastic FE body (J2 flow theory, :mod:`hpfebe.constitutive.j2`) for Chapter 4's
 work piece (Sections 4.2.2-4.2.3, 4.2.6): P1 triangles or Q1 quadrilaterals (scikit-fem),
 history (eps_p, alpha, beta) at the quadrature points, internal force and algorithmic
 tangent assembled vectorised (numpy matmul/einsum over elements and points).
@@ -24,8 +24,8 @@ it only after a load step converged); a failed, cut load step therefore restarts
 committed state automatically.  :class:`PlasticFEBody` wraps the body as a contact
 :class:`~hpfebe.bodies.body.FEBody` (kind "FE", segments, traces, dofs ...).
 
-:class:`DisplacementSteps` is the :class:`hpfebe.nonlinear.LoadStep` of a body alone under
-prescribed displacements and loads (no contact), for :func:`hpfebe.nonlinear.load_path`.
+:class:`DisplacementSteps` is the :class:`hpfebe.solvers.nonlinear.LoadStep` of a body alone under
+prescribed displacements and loads (no contact), for :func:`hpfebe.solvers.nonlinear.load_path`.
 """
 
 from __future__ import annotations
@@ -37,10 +37,10 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 from skfem import Basis, ElementQuad1, ElementTriP1, ElementVector, MeshQuad, MeshTri
 
-from ..nonlinear import Iterate, SingularStep
+from ..solvers import Iterate, SingularStep
 from .elasticity import ElasticBody
 from .meshes import FEDomain
-from .plasticity import (J2Material, J2State, consistent_tangent, dev, return_map,
+from ..constitutive.j2 import (J2Material, J2State, consistent_tangent, dev, return_map,
                          tensor_norm, TANGENTS)
 
 FORMULATIONS = ("bbar", "full")
@@ -198,7 +198,7 @@ class ElastoPlasticFE:
     # ------------------------------------------------------------------ protocol
     def state_at(self, u: np.ndarray):
         """The return map at u from the committed history without its tangent:
-        (f_int, :class:`~hpfebe.fem.plasticity.ReturnMap`), cached for the last u; the
+        (f_int, :class:`~hpfebe.constitutive.j2.ReturnMap`), cached for the last u; the
         tangent follows from :meth:`tangent_matrix` when it is needed (a Newton step,
         not a rejected line-search trial)."""
         key = np.asarray(u, dtype=float)
@@ -211,8 +211,8 @@ class ElastoPlasticFE:
 
     def response(self, u: np.ndarray, tangent: str | None = None):
         """The return map at u from the committed history: (f_int, tangent matrix,
-        :class:`~hpfebe.fem.plasticity.ReturnMap`); the ReturnMap's pointwise tangent
-        is not formed (:func:`~hpfebe.fem.plasticity.consistent_tangent` gives it)."""
+        :class:`~hpfebe.constitutive.j2.ReturnMap`); the ReturnMap's pointwise tangent
+        is not formed (:func:`~hpfebe.constitutive.j2.consistent_tangent` gives it)."""
         tg = self.tangent if tangent is None else tangent
         f, rm = self.state_at(u)
         T = self._cache[3].get(tg)
@@ -294,7 +294,7 @@ class ElastoPlasticFE:
 
 
 class DisplacementSteps:
-    """Load steps of one body alone (:class:`hpfebe.nonlinear.LoadStep`): at load factor
+    """Load steps of one body alone (:class:`hpfebe.solvers.nonlinear.LoadStep`): at load factor
     lam the dofs ``fixed`` are prescribed to lam * ``values`` and the external load is
     lam * ``f_ext``; residual R = f_int(u) - lam f_ext on the free dofs, merit 1/2 |R|^2,
     force scale max |f_int| (reactions included); each step starts from the secant

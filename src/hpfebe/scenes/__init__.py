@@ -1,6 +1,8 @@
 """The thesis's scenes: geometries, loads and material data of its examples, built from
 the core (bodies, contact problems); experiments and tests import them.
 
+* :mod:`.materials` - the material data of every Chapter 3-4 scene (E = 266926, nu = 0.29,
+  mu_f = 0.1, sigma_Y = 4, H = 450).
 * :mod:`.stamping` - the stamping examples of Section 4.2.7 (FE or BE stamp on an
   elastoplastic FE or BE work piece, one touch of incremental loading).
 

@@ -38,7 +38,7 @@ from ..bem.lame import LameBEM
 from ..geometry import BoundaryMesh
 from ..fem.elasticity import ElasticBody, rectangle_mesh
 from ..fem.plastic_body import ElastoPlasticFE
-from ..fem.plasticity import J2Material
+from ..constitutive.j2 import J2Material
 from ..bodies import BEBody, PlasticBEBody, PlasticFEBody
 from ..bodies.plastic_be import rectangle_work_piece
 from ..contact.loading import LU_ORDERINGS

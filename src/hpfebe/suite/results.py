@@ -1,0 +1,695 @@
+"""What an experiment hands back, and how it is written to ``results/``.
+
+An experiment module returns a list of :class:`ArtefactResult` (one per thesis table or
+figure it produces); :func:`write_result` turns each into
+
+    <out>/<name>.csv    the table (published columns first, then dof, wall_time_s, ...)
+    <out>/<name>.json   claims, notes, meta, keys, tolerances, published file, provenance
+    <out>/<name>.png    the figure, if there is one
+
+Every file is written atomically (temporary file in the same directory, fsync,
+``os.replace``): an interrupted run never leaves a half-written file under the final
+name, and the temporary file is removed on any exception and, through
+:func:`remove_temporaries`, by the command line's SIGTERM/SIGINT handler.  The JSON file
+is written last, so a result is complete when its JSON exists.  The JSON records what
+the result holds (``n_rows``, ``columns``, ``has_figure`` and, under ``files``, the size
+and sha256 of the CSV and PNG written); :func:`check_result` compares the files against
+it, so that a truncated, replaced or emptied file is found "damaged" and never used.
+
+Claims that recur are built by helpers, so that the verdict and its evidence read the
+same everywhere: :func:`rate_claim` (an observed rate against the expected one),
+:func:`beats_uniform_claim` (adaptive against uniform refinement at equal DOF) and
+:func:`range_claim` (a computed range against a published one, e.g. a colorbar: each
+extreme by its relative difference), and
+:func:`joint_claim` (one statement made of several checked parts).
+
+This is an edge module: no numerics (the log-log interpolation is
+:func:`hpfebe.analysis.rates.loglog_interpolate`), only data containers, claims and
+file writing.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import io
+import json
+import math
+import os
+import platform
+import subprocess
+import sys
+import tempfile
+from dataclasses import dataclass, field
+from datetime import datetime, timezone
+from importlib import metadata
+from pathlib import Path
+from typing import Any, Callable, Iterable
+
+import numpy as np
+import pandas as pd
+
+__all__ = [
+    "Claim",
+    "CLAIM_KINDS",
+    "CELLS_PREFIX",
+    "rate_claim",
+    "beats_uniform_claim",
+    "range_claim",
+    "joint_claim",
+    "ArtefactResult",
+    "write_result",
+    "read_result",
+    "check_result",
+    "DamagedResult",
+    "atomic_write",
+    "remove_temporaries",
+    "provenance",
+    "progress",
+    "TOLERANCE_KINDS",
+]
+
+#: tolerance kinds: ("factor", f) - reproduced/published within [1/f, f];
+#: ("abs", a) - |reproduced - published| <= a
+TOLERANCE_KINDS = ("factor", "abs")
+
+#: packages whose versions are recorded in every result's provenance
+PROVENANCE_PACKAGES = ("numpy", "scipy", "numba", "scikit-fem", "pandas", "matplotlib",
+                       "hpfebe")
+
+
+#: what a claim is (the report counts ``thesis`` claims in its summary, the others apart):
+#: ``thesis`` - a statement the thesis makes, checked against what was measured;
+#: ``explanation`` - our computed test of a cause for a difference (it could have
+#: failed, and it survives the changes it should not depend on), linked by ``explains``
+#: to the claims or cells it explains; ``hypothesis`` - a numerical coincidence or a
+#: reading not derived, linked the same way; ``beyond`` - a result beyond the thesis.
+CLAIM_KINDS = ("thesis", "explanation", "hypothesis", "beyond")
+
+#: an ``explains`` entry naming table cells instead of a claim id: ``"cells:*"`` (every
+#: off cell of the artefact's table), ``"cells:<column>"`` (every off cell of that
+#: column) or ``"cells:<column>[key=value,...]"`` (the off cells of the rows whose key
+#: columns have those values, compared as numbers where they parse as numbers)
+CELLS_PREFIX = "cells:"
+
+
+@dataclass
+class Claim:
+    """A checked statement about an artefact.
+
+    text : the statement, e.g. "BE energy rate of the h-version ~0.66 (theory 2/3)"
+    holds : True (holds), False (differs), None (not decidable here, e.g. evaluated
+        over zero converged runs)
+    evidence : the measured numbers that decide it
+    kind : one of :data:`CLAIM_KINDS` (default ``"thesis"``)
+    id : a short name, unique within the artefact, that ``explains`` entries refer to
+    explains : for ``explanation`` and ``hypothesis`` claims: the ids of the claims of
+        the same artefact, and the cells (:data:`CELLS_PREFIX`), whose difference this
+        claim accounts for
+    """
+
+    text: str
+    holds: bool | None
+    evidence: str = ""
+    kind: str = "thesis"
+    id: str = ""
+    explains: tuple[str, ...] = ()
+
+
+def _finite(name: str, v) -> float:
+    try:
+        x = float(v)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} must be a number, got {v!r}") from None
+    if not math.isfinite(x):
+        raise ValueError(f"{name} must be finite, got {v!r}")
+    return x
+
+
+def rate_claim(statement: str, observed: float, expected: float, tol: float,
+               what: str = "rate") -> Claim:
+    """Holds iff |observed - expected| <= tol (a NaN observation does not hold)."""
+    expected, tol = _finite("expected", expected), _finite("tol", tol)
+    if tol < 0:
+        raise ValueError(f"tol must be >= 0, got {tol!r}")
+    observed = float(observed)
+    holds = bool(abs(observed - expected) <= tol)
+    return Claim(statement, holds, f"observed {what} {observed:.3f}, expected {expected:.4g} "
+                                   f"+- {tol:g}")
+
+
+def beats_uniform_claim(statement: str, dof_adaptive, err_adaptive, dof_uniform,
+                        err_uniform, factor: float = 1.0) -> Claim:
+    """Adaptive against uniform refinement at equal DOF: holds iff the last adaptive
+    error is below ``factor`` x the uniform error log-log interpolated at the last
+    adaptive DOF; not decidable (holds None) if the uniform DOF range does not contain
+    that DOF."""
+    from ..analysis.rates import loglog_interpolate
+
+    factor = _finite("factor", factor)
+    if factor <= 0:
+        raise ValueError(f"factor must be > 0, got {factor!r}")
+    dof_a, err_a = np.asarray(dof_adaptive, float), np.asarray(err_adaptive, float)
+    dof_u = np.asarray(dof_uniform, float)
+    if dof_a.size == 0 or dof_a.shape != err_a.shape:
+        raise ValueError(f"dof_adaptive and err_adaptive must be non-empty and of equal "
+                         f"length, got {dof_a.shape}, {err_a.shape}")
+    d, e = float(dof_a[-1]), float(err_a[-1])
+    head = f"last adaptive step: {d:.0f} DOF, error {e:.4g}"
+    if dof_u.size == 0 or not dof_u.min() <= d <= dof_u.max():
+        rng = f"{dof_u.min():.0f}..{dof_u.max():.0f}" if dof_u.size else "none"
+        return Claim(statement, None, f"{head}; the uniform DOF range ({rng}) does not "
+                                      "contain it: not decidable")
+    e_u = loglog_interpolate(d, dof_u, err_uniform)
+    cond = f"below {factor:g} x uniform" if factor != 1.0 else "below uniform"
+    return Claim(statement, bool(e < factor * e_u),
+                 f"{head}; uniform at that DOF (log-log interpolated) {e_u:.4g}; ratio "
+                 f"{e / e_u:.3f} (holds if {cond})")
+
+
+#: the extremes of a range, as :func:`range_claim` names them
+RANGE_EXTREMES = ("min", "max")
+
+
+def range_claim(statement: str, name: str, ours, published, rel_tol: float,
+                fixed: Iterable[str] = ()) -> Claim:
+    """A computed range ``ours = (lo, hi)`` against a published one (e.g. a colour
+    bar): holds iff each extreme is within ``rel_tol`` of the published one, relative
+    to it: |lo - plo| / |plo| and |hi - phi| / |phi| (the relative difference of each
+    max/min, not a share of the span).  A published extreme 0 has no relative
+    difference: there the absolute difference, as a share of the published span,
+    counts (and the evidence says so).
+
+    ``fixed`` names the extremes (``"min"``, ``"max"``) that are fixed by construction,
+    e.g. a Dirichlet value: they are no evidence, so they are not tested (the evidence
+    says so and still shows them)."""
+    rel_tol = _finite("rel_tol", rel_tol)
+    if rel_tol < 0:
+        raise ValueError(f"rel_tol must be >= 0, got {rel_tol!r}")
+    try:
+        lo, hi = (_finite(f"ours[{i}]", v) for i, v in enumerate(ours))
+        plo, phi = (_finite(f"published[{i}]", v) for i, v in enumerate(published))
+    except (TypeError, ValueError) as err:
+        raise ValueError(f"ours and published must be (lo, hi) pairs: {err}") from None
+    span = abs(phi - plo)
+    if span == 0:
+        raise ValueError(f"published range must have a non-zero span, got {published!r}")
+    fixed = tuple(fixed) if not isinstance(fixed, str) else (fixed,)
+    bad = [f for f in fixed if f not in RANGE_EXTREMES]
+    if bad or len(set(fixed)) == len(RANGE_EXTREMES):
+        raise ValueError(f"fixed must name at most one of {RANGE_EXTREMES} (an extreme "
+                         f"fixed by construction), got {fixed!r}")
+    parts, devs = [], []
+    for which, v, pv in (("min", lo, plo), ("max", hi, phi)):
+        if which in fixed:
+            parts.append(f"{which} {v:.4e} fixed by construction (published {pv:.4e}): "
+                         "no evidence, not tested")
+            continue
+        if pv != 0:
+            dev = abs(v - pv) / abs(pv)
+            parts.append(f"{which} {v:.4e} against {pv:.4e}: {100 * dev:.1f} % off")
+        else:
+            dev = abs(v) / span
+            parts.append(f"{which} {v:.4e} against 0: |{which}| = {100 * dev:.1f} % of "
+                         "the published span (absolute: no relative difference to 0)")
+        devs.append(dev)
+    return Claim(statement, bool(max(devs) <= rel_tol),
+                 f"{name} {lo:.4e}..{hi:.4e} (published {plo:.4e}..{phi:.4e}): "
+                 + "; ".join(parts) + f" (tolerance {100 * rel_tol:g} % of each extreme)")
+
+
+def joint_claim(statement: str, *parts: Claim, note: str = "") -> Claim:
+    """One statement that holds iff every part holds: False if any part is False, else
+    None if any is undecidable, else True; the evidence joins the parts' evidence
+    (``"; "``) and ``note``."""
+    if not parts or not all(isinstance(c, Claim) for c in parts):
+        raise ValueError("joint_claim needs at least one Claim part")
+    verdicts = [c.holds for c in parts]
+    holds = False if False in verdicts else (None if None in verdicts else True)
+    evidence = "; ".join(c.evidence for c in parts if c.evidence)
+    return Claim(statement, holds, evidence + (f" ({note})" if note else ""))
+
+
+@dataclass
+class ArtefactResult:
+    """One thesis artefact (table or figure) as reproduced.
+
+    name : artefact id as in EXPERIMENTS.md, e.g. "table_2_1"
+    table : published columns first (same names as report/published/<file>.csv),
+        then dof, wall_time_s, ...
+    figure : matplotlib figure (required for ``figure_*`` artefacts)
+    published : file name in report/published/, e.g. "table_2_1_nitsche_smooth_h_BE.csv"
+    keys : columns joining the reproduced with the published table
+    tolerances : column -> ("factor", 2.0) or ("abs", 0.15)
+    claims : the thesis's statements, checked
+    notes : choices and explanations shown in the report
+    meta : timings (jit_s, run_s), dof, iterations, ...; ``allow_nan_columns`` lists
+        float columns that may contain NaN (e.g. the first rate of a sweep)
+    exports : {key: meshio.Mesh} meshes with fields for ParaView, written as
+        ``<out>/<name>_<key>.vtu`` (see :mod:`hpfebe.io.vtu`)
+    """
+
+    name: str
+    table: pd.DataFrame
+    figure: Any = None
+    published: str | None = None
+    keys: tuple[str, ...] = ()
+    tolerances: dict[str, tuple[str, float]] = field(default_factory=dict)
+    claims: list[Claim] = field(default_factory=list)
+    notes: str = ""
+    meta: dict = field(default_factory=dict)
+    exports: dict[str, Any] = field(default_factory=dict)
+
+
+# --------------------------------------------------------------------------- progress
+def progress(iterable: Iterable, **kw):
+    """tqdm progress bar on stderr, shown only when stderr is a terminal (quiet in
+    Snakemake jobs, CI and log files).  Keyword arguments go to ``tqdm``."""
+    from tqdm.auto import tqdm
+
+    kw.setdefault("disable", not sys.stderr.isatty())
+    kw.setdefault("file", sys.stderr)
+    return tqdm(iterable, **kw)
+
+
+# --------------------------------------------------------------------------- provenance
+def _repo_root() -> Path:
+    """The repository holding this (editable) package: parent of ``src/``."""
+    return Path(__file__).resolve().parents[2]
+
+
+def _git(*args: str, cwd: Path) -> str | None:
+    try:
+        out = subprocess.run(["git", *args], cwd=cwd, capture_output=True, text=True,
+                             timeout=10, check=True)
+    except (OSError, subprocess.SubprocessError):
+        return None
+    return out.stdout.strip() or None
+
+
+def _version(pkg: str) -> str:
+    try:
+        return metadata.version(pkg)
+    except metadata.PackageNotFoundError:
+        return "not installed"
+
+
+def provenance(config: dict | None = None, run_info: dict | None = None) -> dict:
+    """Where a result comes from: git commit (or "unknown"), whether the work tree had
+    uncommitted changes, package and Python versions, the config used, the UTC date,
+    the host's CPU count and the thread-count environment variables."""
+    root = _repo_root()
+    commit = _git("rev-parse", "HEAD", cwd=root)
+    status = _git("status", "--porcelain", "--untracked-files=no", cwd=root) if commit else None
+    try:
+        affinity = len(os.sched_getaffinity(0))
+    except (AttributeError, OSError):
+        affinity = None
+    prov = {
+        "git_commit": commit or "unknown",
+        "git_dirty": (status is not None) if commit else None,
+        "packages": {pkg: _version(pkg) for pkg in PROVENANCE_PACKAGES},
+        "python": platform.python_version(),
+        "platform": platform.platform(),
+        "config": config if config is not None else {},
+        "date_utc": datetime.now(timezone.utc).isoformat(timespec="seconds"),
+        "host_cpu_count": os.cpu_count(),
+        "cpus_available": affinity,
+        "threads_env": {k: os.environ.get(k) for k in (
+            "NUMBA_NUM_THREADS", "OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS",
+            "MKL_NUM_THREADS")},
+    }
+    if run_info:
+        prov["run"] = run_info
+    return prov
+
+
+# --------------------------------------------------------------------------- atomic I/O
+def _umask() -> int:
+    mask = os.umask(0)
+    os.umask(mask)
+    return mask
+
+
+#: temporary files of atomic writes in progress (removed by remove_temporaries)
+_ACTIVE_TEMPORARIES: set[str] = set()
+
+
+def remove_temporaries() -> list[str]:
+    """Remove the temporary files of atomic writes in progress (for a signal handler:
+    the process is about to exit).  Returns the paths removed."""
+    removed = []
+    for tmp in list(_ACTIVE_TEMPORARIES):
+        try:
+            os.unlink(tmp)
+            removed.append(tmp)
+        except OSError:
+            pass
+        _ACTIVE_TEMPORARIES.discard(tmp)
+    return removed
+
+
+def atomic_write(path: Path | str, writer: Callable[[Any], None], mode: str = "w") -> Path:
+    """Write ``path`` atomically: ``writer(f)`` fills a temporary file in the same
+    directory, which is flushed, fsync'ed and renamed over ``path``.  If anything
+    raises (``BaseException``: also KeyboardInterrupt, SystemExit and the command line's
+    signal exits), the temporary file is removed and ``path`` is left as it was; while
+    the write is in progress the temporary file is registered for
+    :func:`remove_temporaries`."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+    _ACTIVE_TEMPORARIES.add(tmp)
+    try:
+        os.chmod(tmp, 0o666 & ~_umask())  # mkstemp makes 0600; give the usual mode
+        with os.fdopen(fd, mode, **({} if "b" in mode else {"encoding": "utf-8",
+                                                             "newline": ""})) as f:
+            writer(f)
+            f.flush()
+            os.fsync(f.fileno())
+        os.replace(tmp, path)
+    except BaseException:
+        try:
+            os.unlink(tmp)
+        except FileNotFoundError:
+            pass
+        raise
+    finally:
+        _ACTIVE_TEMPORARIES.discard(tmp)
+    try:  # make the rename itself durable (best effort, not on every platform)
+        dfd = os.open(path.parent, os.O_RDONLY)
+        try:
+            os.fsync(dfd)
+        finally:
+            os.close(dfd)
+    except OSError:
+        pass
+    return path
+
+
+def _jsonable(obj):
+    """Plain JSON types; non-finite floats become the strings "NaN"/"Infinity"/
+    "-Infinity" (explicit, and the file stays valid JSON)."""
+    if isinstance(obj, dict):
+        return {str(k): _jsonable(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple, set)):
+        return [_jsonable(v) for v in obj]
+    if isinstance(obj, np.ndarray):
+        return [_jsonable(v) for v in obj.tolist()]
+    if isinstance(obj, (bool, np.bool_)):
+        return bool(obj)
+    if isinstance(obj, (int, np.integer)):
+        return int(obj)
+    if isinstance(obj, (float, np.floating)):
+        x = float(obj)
+        if math.isnan(x):
+            return "NaN"
+        if math.isinf(x):
+            return "Infinity" if x > 0 else "-Infinity"
+        return x
+    if obj is None or isinstance(obj, str):
+        return obj
+    if isinstance(obj, Path):
+        return str(obj)
+    return str(obj)
+
+
+# --------------------------------------------------------------------------- validation
+def validate(result: ArtefactResult) -> None:
+    """Check a result against the contract; ``ValueError`` names what is wrong."""
+    name = result.name
+    if not isinstance(name, str) or not name or any(c in name for c in "/\\ ."):
+        raise ValueError(f"result name must be a plain artefact id like 'table_2_1', "
+                         f"got {name!r}")
+    if not isinstance(result.table, pd.DataFrame):
+        raise ValueError(f"{name}: table must be a pandas.DataFrame, got "
+                         f"{type(result.table).__name__}")
+    cols = [str(c) for c in result.table.columns]
+    if len(set(cols)) != len(cols):
+        dup = sorted({c for c in cols if cols.count(c) > 1})
+        raise ValueError(f"{name}: duplicate table columns {dup}")
+    for k in result.keys:
+        if k not in cols:
+            raise ValueError(f"{name}: key column {k!r} is not in the table (columns: {cols})")
+    for col, tol in result.tolerances.items():
+        if col not in cols:
+            raise ValueError(f"{name}: tolerance column {col!r} is not in the table "
+                             f"(columns: {cols})")
+        if (not isinstance(tol, (tuple, list)) or len(tol) != 2
+                or tol[0] not in TOLERANCE_KINDS):
+            raise ValueError(f"{name}: tolerance for {col!r} must be ('factor', f) or "
+                             f"('abs', a), got {tol!r}")
+        if not (isinstance(tol[1], (int, float)) and math.isfinite(tol[1]) and tol[1] >= 0
+                and (tol[0] != "factor" or tol[1] >= 1)):
+            raise ValueError(f"{name}: tolerance value for {col!r} must be finite, >= 0 "
+                             f"(>= 1 for 'factor'), got {tol[1]!r}")
+    if result.tolerances and result.published and not result.keys:
+        raise ValueError(f"{name}: tolerances against a published table need join keys")
+    if result.published is not None and (
+            not isinstance(result.published, str) or "/" in result.published):
+        raise ValueError(f"{name}: published must be a file name in report/published/, "
+                         f"got {result.published!r}")
+    for c in result.claims:
+        if not isinstance(c, Claim):
+            raise ValueError(f"{name}: claims must be Claim objects, got {type(c).__name__}")
+        if c.holds not in (True, False, None):
+            raise ValueError(f"{name}: Claim.holds must be True, False or None, got "
+                             f"{c.holds!r} for {c.text!r}")
+        if c.kind not in CLAIM_KINDS:
+            raise ValueError(f"{name}: Claim.kind must be one of {CLAIM_KINDS}, got "
+                             f"{c.kind!r} for {c.text!r}")
+        if not isinstance(c.explains, (tuple, list)) or not all(
+                isinstance(x, str) and x for x in c.explains):
+            raise ValueError(f"{name}: Claim.explains must be a tuple of claim ids or "
+                             f"'cells:...' names, got {c.explains!r} for {c.text!r}")
+        if c.explains and c.kind not in ("explanation", "hypothesis"):
+            raise ValueError(f"{name}: only explanation and hypothesis claims explain "
+                             f"something; {c.kind} claim {c.text!r} has explains="
+                             f"{tuple(c.explains)!r}")
+    ids = [c.id for c in result.claims if c.id]
+    if len(set(ids)) != len(ids):
+        raise ValueError(f"{name}: claim ids must be unique, got {ids}")
+    for c in result.claims:
+        for x in c.explains:
+            if not x.startswith(CELLS_PREFIX) and x not in ids:
+                raise ValueError(f"{name}: claim {c.text!r} explains {x!r}, which is "
+                                 f"neither a claim id of this artefact ({ids}) nor a "
+                                 f"'{CELLS_PREFIX}...' name")
+    allowed = set(result.meta.get("allow_nan_columns", ()))
+    unknown = allowed - set(cols)
+    if unknown:
+        raise ValueError(f"{name}: allow_nan_columns names columns not in the table: "
+                         f"{sorted(unknown)}")
+    for col in result.table.columns:
+        s = result.table[col]
+        if str(col) in allowed:
+            continue
+        bad = s.isna()  # NaN in float columns, NaN/None/NA in text or nullable ones
+        if bad.any():
+            raise ValueError(
+                f"{name}: column {col!r} has NaN (missing values) in {int(bad.sum())} "
+                f"row(s) (first row "
+                f"{int(np.flatnonzero(bad.to_numpy())[0])}); NaN is allowed only in "
+                "columns listed in meta['allow_nan_columns'] and explained in notes")
+    if name.startswith("figure_") and result.figure is None:
+        raise ValueError(f"{name}: figure artefacts must return a figure")
+
+
+# --------------------------------------------------------------------------- writing
+def write_result(result: ArtefactResult, out_dir: Path | str, config: dict | None = None,
+                 *, run_info: dict | None = None) -> list[Path]:
+    """Write ``<out>/<name>.csv``, ``.png`` (if there is a figure) and ``.json``
+    (last), each atomically.  Returns the paths written.
+
+    Raises ValueError (naming the column) if a float column has NaN that is not in
+    ``result.meta['allow_nan_columns']``, and for any other breach of the contract.
+    ``run_info`` (quick flag, config files, wall time of the run) goes into the
+    provenance."""
+    validate(result)
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    written = []
+
+    table = result.table.copy()
+    table.columns = [str(c) for c in table.columns]
+    csv_bytes = table.to_csv(index=False).encode("utf-8")
+    written.append(atomic_write(out / f"{result.name}.csv", lambda f: f.write(csv_bytes),
+                                mode="wb"))
+    files = {"csv": _file_record(written[-1].name, csv_bytes), "png": None}
+
+    png = out / f"{result.name}.png"
+    if result.figure is not None:
+        buf = io.BytesIO()
+        result.figure.savefig(buf, format="png", dpi=120, bbox_inches="tight")
+        png_bytes = buf.getvalue()
+        written.append(atomic_write(png, lambda f: f.write(png_bytes), mode="wb"))
+        files["png"] = _file_record(png.name, png_bytes)
+    elif png.exists():  # a stale figure from an earlier run would be mistaken as current
+        png.unlink()
+
+    exports = []
+    if result.exports:
+        from ..io.vtu import write_vtu
+
+        for key, mesh in result.exports.items():
+            if not str(key).isidentifier():
+                raise ValueError(f"exports key {key!r} must be an identifier (file name part)")
+            written.append(write_vtu(out / f"{result.name}_{key}.vtu", mesh))
+            exports.append(written[-1].name)
+
+    doc = {
+        "name": result.name,
+        "kind": artefact_kind(result.name),
+        "published": result.published,
+        "keys": list(result.keys),
+        "tolerances": {k: [v[0], v[1]] for k, v in result.tolerances.items()},
+        "claims": [{"text": c.text, "holds": c.holds, "evidence": c.evidence,
+                    "kind": c.kind, "id": c.id, "explains": list(c.explains)}
+                   for c in result.claims],
+        "notes": result.notes,
+        "meta": result.meta,
+        "columns": list(table.columns),
+        "n_rows": int(len(table)),
+        "has_figure": result.figure is not None,
+        "files": files,
+        "exports": exports,
+        "provenance": provenance(config, run_info),
+    }
+    text = json.dumps(_jsonable(doc), indent=2, allow_nan=False) + "\n"
+    written.append(atomic_write(out / f"{result.name}.json", lambda f: f.write(text)))
+    return written
+
+
+def artefact_kind(name: str) -> str:
+    """'table' for table_*, 'figure' for figure_*, else 'other'."""
+    if name.startswith("table_"):
+        return "table"
+    if name.startswith("figure_"):
+        return "figure"
+    return "other"
+
+
+def _file_record(name: str, data: bytes) -> dict:
+    return {"name": name, "bytes": len(data), "sha256": hashlib.sha256(data).hexdigest()}
+
+
+class DamagedResult(ValueError):
+    """A result whose files do not match what its JSON says it holds; ``problems``
+    lists every mismatch."""
+
+    def __init__(self, name: str, problems: list[str]):
+        super().__init__(f"{name}: damaged result: " + "; ".join(problems))
+        self.name, self.problems = name, problems
+
+
+_PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
+
+
+def _check_file(path: Path, record, what: str, problems: list[str]) -> bytes | None:
+    """The bytes of ``path`` if it matches ``record`` (size and sha256 from the JSON;
+    None = not recorded, by an older writer), else None with the mismatch in
+    ``problems``."""
+    if not path.is_file():
+        problems.append(f"{what} file {path.name} is missing")
+        return None
+    data = path.read_bytes()
+    if not data:
+        problems.append(f"{what} file {path.name} is empty (0 bytes)")
+        return None
+    if isinstance(record, dict):
+        if record.get("bytes") is not None and record.get("bytes") != len(data):
+            problems.append(f"{what} file {path.name} has {len(data)} bytes, the JSON "
+                            f"records {record.get('bytes')}")
+            return None
+        if record.get("sha256") and record["sha256"] != hashlib.sha256(data).hexdigest():
+            problems.append(f"{what} file {path.name}: sha256 differs from the one "
+                            "recorded in the JSON (changed after it was written)")
+            return None
+    return data
+
+
+def check_result(results_dir: Path | str, name: str
+                 ) -> tuple[dict, pd.DataFrame, Path | None] | None:
+    """The checked JSON document, table and figure path (None if the result has no
+    figure) of a written result; None if its JSON is missing (not built, or
+    interrupted before the JSON was written).
+
+    Raises :class:`DamagedResult` listing every mismatch if the JSON is not a JSON
+    object, or the CSV/PNG do not match what the JSON records (size and sha256 of the
+    files written, row count, columns, figure present; a PNG must be a PNG)."""
+    d = Path(results_dir)
+    js, csv, png = d / f"{name}.json", d / f"{name}.csv", d / f"{name}.png"
+    if not js.exists():
+        return None
+    try:
+        with open(js, encoding="utf-8") as f:
+            doc = json.load(f)
+    except (OSError, ValueError) as exc:
+        raise DamagedResult(name, [f"{js.name} is not valid JSON ({exc})"]) from None
+    if not isinstance(doc, dict):
+        raise DamagedResult(name, [f"{js.name} holds a JSON {type(doc).__name__}, not an "
+                                   "object"])
+    problems: list[str] = []
+    for key, tp, what in (("claims", list, "a list"), ("meta", dict, "an object"),
+                          ("provenance", dict, "an object"), ("notes", str, "a string"),
+                          ("keys", list, "a list"), ("tolerances", dict, "an object"),
+                          ("files", dict, "an object")):
+        if doc.get(key) is not None and not isinstance(doc[key], tp):
+            problems.append(f"{js.name}: {key!r} must be {what}, got "
+                            f"{type(doc[key]).__name__}")
+    run = doc["provenance"].get("run") if isinstance(doc.get("provenance"), dict) else None
+    if run is not None and not isinstance(run, dict):
+        problems.append(f"{js.name}: 'provenance.run' must be an object")
+    if isinstance(doc.get("claims"), list) and not all(
+            isinstance(c, dict) for c in doc["claims"]):
+        problems.append(f"{js.name}: every claim must be an object")
+    if problems:
+        raise DamagedResult(name, problems)
+    files = doc.get("files") if isinstance(doc.get("files"), dict) else {}
+    data = _check_file(csv, files.get("csv"), "table", problems)
+    table = None
+    if data is not None:
+        try:
+            table = pd.read_csv(io.BytesIO(data))
+        except Exception as exc:  # noqa: BLE001 - any parse failure is damage
+            problems.append(f"table file {csv.name} cannot be read ({exc})")
+    if table is not None:
+        cols = doc.get("columns")
+        if isinstance(cols, list) and [str(c) for c in table.columns] != cols:
+            problems.append(f"table columns {list(table.columns)} differ from the JSON's "
+                            f"{cols}")
+        n = doc.get("n_rows")
+        if isinstance(n, int) and len(table) != n:
+            problems.append(f"table has {len(table)} rows, the JSON records {n}")
+    png_path = None
+    if doc.get("has_figure"):
+        img = _check_file(png, files.get("png"), "figure", problems)
+        if img is not None and not img.startswith(_PNG_SIGNATURE):
+            problems.append(f"figure file {png.name} is not a PNG image")
+        elif img is not None:
+            png_path = png
+    if problems:
+        raise DamagedResult(name, problems)
+    return doc, table, png_path
+
+
+def read_result(results_dir: Path | str, name: str) -> tuple[dict, pd.DataFrame] | None:
+    """The JSON document and the table of a written result, or None if either is
+    missing (not built, or interrupted before the JSON was written); DamagedResult
+    (a ValueError) if the files do not match what the JSON records (see
+    :func:`check_result`)."""
+    d = Path(results_dir)
+    if not (d / f"{name}.json").exists() or not (d / f"{name}.csv").exists():
+        return None
+    doc, table, _ = check_result(d, name)
+    return doc, table
+
+
+def published_file_for(name: str, published_dir: Path) -> Path | None:
+    """report/published/<name>.csv or <name>_*.csv, if there is one."""
+    if not published_dir.is_dir():
+        return None
+    exact = published_dir / f"{name}.csv"
+    if exact.is_file():
+        return exact
+    hits = sorted(published_dir.glob(f"{name}_*.csv"))
+    return hits[0] if hits else None
