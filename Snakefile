@@ -33,7 +33,41 @@ configfile: "config/config.yaml"
 sys.path.insert(0, workflow.basedir)
 from experiments.registry import discover, unknown_sections  # noqa: E402  (stdlib only)
 
-REGISTRY = discover(Path(workflow.basedir) / "experiments")
+
+
+def discover_cached(directory):
+    """``discover(directory)``, reused from .snakemake/hpfebe/registry.pickle while no
+    file under ``directory`` changed (path, size, mtime).  Parsing every experiment file
+    takes about 0.5 s of CPU, and on a cluster the Snakefile is read again by the nested
+    Snakemakes of every job (a SLURM job of k jobs: 1 + k of them; Snakemake itself
+    starts in about 2 s).  Only the main Snakemake writes the cache, from a fresh
+    discover(); a nested one falls back to discover() on any mismatch or error."""
+    import pickle
+
+    stamp = repr(sorted((str(p), st.st_size, st.st_mtime_ns)
+                        for p in directory.rglob("*.py") if "__pycache__" not in p.parts
+                        for st in [p.stat()]))
+    cache = Path(".snakemake", "hpfebe", "registry.pickle")
+    if not workflow.is_main_process:
+        try:
+            saved, registry = pickle.loads(cache.read_bytes())
+            if saved == stamp:
+                return registry
+        except Exception:  # missing, partly written by an older run, another Python
+            pass
+        return discover(directory)
+    registry = discover(directory)
+    try:
+        cache.parent.mkdir(parents=True, exist_ok=True)
+        tmp = cache.with_name(f".{cache.name}.{os.getpid()}")
+        tmp.write_bytes(pickle.dumps((stamp, registry)))
+        os.replace(tmp, cache)
+    except OSError:   # a read-only checkout: no cache
+        pass
+    return registry
+
+
+REGISTRY = discover_cached(Path(workflow.basedir) / "experiments")
 RESULTS = "results"
 LOGS = f"{RESULTS}/logs"
 QUICK = config.get("quick", False)
@@ -88,18 +122,20 @@ PYTHON = shlex.quote(sys.executable)
 # Interrupted runs: every job watches the Snakemake process that started it (this one:
 # the Snakefile is read by it) and stops when it is gone, even after a SIGKILL, instead
 # of running on as an orphan that writes into results/; SIGTERM/SIGINT/SIGHUP to a job
-# remove its temporary files (hpfebe.cli.install_signal_handlers).  The pid reaches the
-# jobs through the environment they inherit, not through their command: a value that
-# changes on every call must not be part of a job's command, inputs or params (Snakemake
-# would rerun every job every time).  After an interrupted run: `snakemake --unlock`,
-# then rerun (see README, "Reliability").
+# remove its temporary files (hpfebe.suite.watch.install_signal_handlers).  The pid
+# reaches the jobs through the environment they inherit, not through their command: a
+# value that changes on every call must not be part of a job's command, inputs or params
+# (Snakemake would rerun every job every time).  After an interrupted run:
+# `snakemake --unlock`, then rerun (see README, "Reliability").
 # On a cluster a job runs under nested Snakemakes that read this file again (SLURM:
 # sbatch -> snakemake -> srun -> snakemake -> the job): only the main Snakemake sets the
 # variables, the nested ones pass on what they inherited (sbatch --export=ALL).  A job
 # on the main Snakemake's host watches its pid; a job on another host watches the
 # heartbeat file that the main Snakemake rewrites every second (onstart below: where jobs
-# run elsewhere), and stops when it has not changed for 10 s (hpfebe.cli
-# HEARTBEAT_TIMEOUT_S, watch_heartbeat).
+# run elsewhere), and stops when it has not changed for 10 s (hpfebe.suite.watch
+# HEARTBEAT_TIMEOUT_S, watch_heartbeat).  Besides the watch's 1 s poll, every rename of a
+# result file checks the parent first and is aborted if it is gone (hpfebe.suite.watch
+# before_rename): no result lands after the main Snakemake's death.
 if workflow.is_main_process:
     os.environ["HPFEBE_PARENT_PID"] = str(os.getpid())
     os.environ["HPFEBE_PARENT_HOST"] = socket.gethostname()
@@ -107,7 +143,7 @@ if workflow.is_main_process:
 
 def _main_snakemake_gone():
     """True if the main Snakemake named by the environment has ended (its pid on this
-    host, else its heartbeat file older than 10 s: hpfebe.cli.watch_heartbeat)."""
+    host, else its heartbeat file older than 10 s: hpfebe.suite.watch.watch_heartbeat)."""
     pid, host = os.environ.get("HPFEBE_PARENT_PID"), os.environ.get("HPFEBE_PARENT_HOST")
     if not pid:
         return False
@@ -124,6 +160,26 @@ def _main_snakemake_gone():
     except (PermissionError, ValueError):
         pass
     return False
+
+
+# The SLURM executor plugin (2.8) waits 10 s longer after every status check that saw no
+# job end (up to 180 s): a job ending after a quiet minute was noticed up to 30 s late,
+# on the critical path twice (after numba_cache, after the last job).  In the main
+# Snakemake the wait is capped at the profile's `seconds-between-status-checks` (the
+# plugin uses that setting for nothing else).
+if workflow.is_main_process:
+    try:
+        from snakemake_executor_plugin_slurm import Executor as _SlurmExecutor
+    except ImportError:
+        _SlurmExecutor = None
+    _interval = getattr(_SlurmExecutor, "next_seconds_between_status_checks", None)
+    if isinstance(_interval, property) and _interval.fset is not None:
+
+        def _capped(self, value, _set=_interval.fset):
+            cap = self.workflow.remote_execution_settings.seconds_between_status_checks
+            _set(self, value if value is None or not cap else min(value, cap))
+
+        _SlurmExecutor.next_seconds_between_status_checks = _interval.setter(_capped)
 
 
 # A cluster job that starts after its main Snakemake was killed (it waited in the queue)
@@ -230,24 +286,26 @@ def priority_of(rule):
 
 def slurm_nice(rule):
     """The job's `sbatch --nice` (a resource function: the profile's --groups are known
-    when the jobs are made, not when this file is read): the number of jobs measured
-    longer, times the number of jobs.  The SLURM executor does not pass Snakemake's
-    priority on; SLURM starts jobs of equal priority in the order of submission, which is
-    not this one, and (priority/basic) lowers each job's priority by 1 against the one
-    before: a step of 1 per place would not outweigh that.  A job of a group (profiles/
-    slurm: small jobs run one after another as one SLURM job) counts as long as its
-    share of the group, and all jobs of a group get the same value (Snakemake refuses a
-    group whose jobs ask for different strings)."""
+    when the jobs are made, not when this file is read): the number of SLURM jobs
+    measured longer, times the number of jobs.  The SLURM executor does not pass
+    Snakemake's priority on; SLURM starts jobs of equal priority in the order of
+    submission, which is not this one, and (priority/basic) lowers each job's priority by
+    1 against the one before: a step of 1 per place would not outweigh that.  A SLURM job
+    is a job outside the groups, or a group of the profile (its jobs run one after
+    another as one SLURM job: it counts as long as its jobs together, split over the
+    SLURM jobs that `group-components` makes of it); all jobs of a group get the same
+    value (Snakemake refuses a group whose jobs ask for different strings)."""
 
     def nice(wildcards):
         groups = workflow.group_settings.overwrite_groups
-        wall = JOB_TIMES.get(rule, 0.0)
-        if rule in groups:
-            members = [r for r, g in groups.items() if g == groups[rule]]
-            parts = math.ceil(len(members) / workflow.group_settings.group_components.get(
-                groups[rule], 1))
-            wall = sum(JOB_TIMES.get(r, 0.0) for r in members) / parts
-        longer = sum(t > wall for r, t in JOB_TIMES.items() if r not in groups)
+        parts = workflow.group_settings.group_components
+        units = {r: t for r, t in JOB_TIMES.items() if r not in groups}
+        for g in set(groups.values()):
+            members = [r for r, h in groups.items() if h == g]
+            units[g] = (sum(JOB_TIMES.get(r, 0.0) for r in members)
+                        / math.ceil(len(members) / parts.get(g, 1)))
+        wall = units[groups[rule]] if rule in groups else JOB_TIMES.get(rule, 0.0)
+        longer = sum(t > wall for t in units.values())
         return f"--nice={len(JOB_TIMES) * longer if wall else len(JOB_TIMES) ** 2}"
 
     return nice
@@ -319,7 +377,7 @@ rule report:
     input:
         results=ALL_RESULTS,
         published=sorted(str(p) for p in Path("report/published").glob("*.csv")),
-        builder=sorted(str(p) for p in Path("src/hpfebe/suite").glob("*.py")),
+        builder=sorted(str(p) for p in Path("src/hpfebe/suite").rglob("*.py")),
     output:
         html="report/index.html",
         md="report/report.md",

@@ -10,7 +10,7 @@ is computed once)::
     \"\"\"Which thesis section and equations; every choice made where the thesis is
     silent (these choices are also repeated in the results' ``notes``).\"\"\"
 
-    from hpfebe.suite.results import ArtefactResult, Claim, progress
+    from hpfebe.suite import ArtefactResult, Claim, progress
 
     ARTEFACTS = ("table_2_1", "table_2_2", "figure_2_2")   # ids as in EXPERIMENTS.md
 
@@ -45,7 +45,7 @@ Rules
   sweep, a solver that did not converge).
 * ``claims``: checked statements, each with ``holds`` = True / False / None (not
   decidable here, e.g. evaluated over zero converged runs: never True) and the measured
-  ``evidence``, and a ``kind`` (:data:`hpfebe.suite.results.CLAIM_KINDS`): ``thesis`` (a
+  ``evidence``, and a ``kind`` (:data:`hpfebe.suite.claims.CLAIM_KINDS`): ``thesis`` (a
   statement the thesis makes; the report's summary counts these), ``explanation`` (our
   computed test of a cause for a difference: one that could have failed, and survives
   the changes it should not depend on), ``hypothesis`` (a coincidence or reading not
@@ -60,7 +60,10 @@ Rules
   Logging: ``logging.getLogger(__name__)``; ``hpfebe run`` shows INFO on stderr.
 * Numerics belong in the core (``hpfebe``); plotting in the experiment (matplotlib,
   Agg backend is set by the CLI; create figures with ``matplotlib.figure.Figure`` or
-  ``plt.subplots`` - the CLI closes them after writing).
+  ``plt.subplots`` - the CLI closes them after writing).  The patterns every experiment
+  repeats are in the suite: :mod:`hpfebe.suite.figures` (``new_figure``, ``style_axes``,
+  reference slopes), :mod:`hpfebe.suite.tables` (``published_table``, ``grouped_rates``),
+  :mod:`hpfebe.suite.runs` (``select_scenes``, ``from_config_sections``, ``timed``).
 
 * Scenes: a module whose artefacts come from independent computations declares them,
   ``SCENES = {"scene": ("artefact", ...), ...}``, a literal dict whose values partition

@@ -1,7 +1,6 @@
 """Shared helpers of the Chapter 2 experiments (private, not an experiment module):
-sweep tables, published-format tables, joins with the published tables, reference
-slopes.  The numerics are :func:`hpfebe.coupling.errors.lambda_sweep` and
-:func:`hpfebe.analysis.rates.observed_rates`.
+sweep tables, published-format tables, joins with the published tables.  The numerics
+are :func:`hpfebe.scenes.interface.lambda_sweep` and :func:`hpfebe.analysis.observed_rates`.
 """
 
 from __future__ import annotations
@@ -11,9 +10,9 @@ import logging
 import numpy as np
 import pandas as pd
 
-from hpfebe.analysis.rates import observed_rates
-from hpfebe.coupling.errors import lambda_sweep
-from hpfebe.suite.results import progress
+from hpfebe.analysis import observed_rates
+from hpfebe.scenes import interface
+from hpfebe.suite import progress
 
 logging.getLogger("skfem").setLevel(logging.WARNING)  # one INFO line per assembly otherwise
 
@@ -24,12 +23,10 @@ KEYS = ("series", "h_inv", "p")
 def sweep(name: str, series: str, cases, lambdas, alpha: float, h_def: str,
           desc: str = "", companions: bool = False) -> pd.DataFrame:
     """One row per (case, lambda_Nit) of problem ``name``: cases are (fe_h_inv,
-    be_h_inv, p) triples; columns problem, series, then those of ``lambda_sweep``."""
-    rows = []
-    for fh, bh, p in progress(list(cases), desc=desc or f"{name} {series}"):
-        rows += [dict(problem=name, series=series, **r) for r in
-                 lambda_sweep(name, fh, bh, p, lambdas, alpha, h_def, companions)]
-    return pd.DataFrame(rows)
+    be_h_inv, p) triples; columns problem, series, then those of ``lambda_sweep``
+    (:func:`hpfebe.scenes.interface.sweep_rows`)."""
+    return pd.DataFrame(interface.sweep_rows(name, series, cases, lambdas, alpha, h_def,
+                                             desc, companions, progress))
 
 
 def rates(x, e) -> np.ndarray:
@@ -76,12 +73,3 @@ def compare(table: pd.DataFrame, published: pd.DataFrame, col: str) -> pd.Series
     m = table.merge(published, on=list(KEYS), suffixes=("", "_pub"))
     return m[col] / m[f"{col}_pub"]
 
-
-def add_slope(ax, x, y0, slope, label, below=False, **kw):
-    """Reference line y = y0 (x / x[0])^slope over the range of x, labelled above (or
-    ``below``) its right end, right-aligned so that the label stays inside the axes."""
-    x = np.asarray([np.min(x), np.max(x)], float)
-    ax.loglog(x, y0 * (x / x[0]) ** slope, "k--", lw=0.8, alpha=0.7, **kw)
-    ax.annotate(label, (x[-1], y0 * (x[-1] / x[0]) ** slope), xytext=(0, -3 if below else 3),
-                textcoords="offset points", ha="right", va="top" if below else "bottom",
-                fontsize=7, alpha=0.8)

@@ -23,18 +23,16 @@ contribute O(h^(p+1/2)) in H^-1/2 as well).
 from __future__ import annotations
 
 import logging
-import time
 from dataclasses import dataclass, replace
 
 import numpy as np
 import pandas as pd
-from matplotlib.figure import Figure
 
 from hpfebe import BoundaryMesh
 from hpfebe.analysis import boundary_l2_error, observed_rates
 from hpfebe.bem import LaplaceBEM
-from hpfebe.suite.params import from_config
-from hpfebe.suite.results import ArtefactResult, joint_claim, progress, rate_claim
+from hpfebe.suite import (ArtefactResult, from_config, joint_claim, new_figure, progress,
+                          rate_claim, slope_line, style_axes, timed)
 
 ARTEFACTS = ("figure_bem_laplace",)
 
@@ -91,10 +89,9 @@ def _sweep(p: int, ns, x0, extra) -> pd.DataFrame:
     """Errors and observed rates of degree p on the meshes n = ns."""
     rows = []
     for n in progress(ns, desc=f"p={p}"):
-        t1 = time.perf_counter()
-        err, dof = neumann_l2_error(p, n, x0, extra)
+        (err, dof), seconds = timed(neumann_l2_error, p, n, x0, extra)
         rows.append(dict(p=p, n_per_side=n, h=1.0 / n, dof=dof, l2_error=err,
-                         wall_time_s=time.perf_counter() - t1))
+                         wall_time_s=seconds))
         log.info("p=%d n=%d dof=%d error=%.3e", p, n, dof, err)
     t = pd.DataFrame(rows)
     t.insert(5, "l2_rate", observed_rates(t.h.to_numpy(), t.l2_error.to_numpy()))
@@ -102,23 +99,18 @@ def _sweep(p: int, ns, x0, extra) -> pd.DataFrame:
 
 
 def _figure(table, degrees, ns):
-    fig = Figure(figsize=(6.0, 4.5))
-    ax = fig.subplots()
+    fig, ax = new_figure((6.0, 4.5))
     for p in degrees:
         sub = table[table.p == p]
         line, = ax.loglog(sub.h, sub.l2_error, "o-", label=f"p = {p}")
-        h_ref = sub.h.to_numpy()
-        e_ref = sub.l2_error.iloc[-1] * (h_ref / h_ref[-1]) ** p * 0.6
-        ax.loglog(h_ref, e_ref, "--", color=line.get_color(), alpha=0.6,
-                  label=f"$h^{p}$ (reference)")
+        slope_line(ax, sub.h, p, (sub.h.iloc[-1], 0.6 * sub.l2_error.iloc[-1]), "--",
+                   color=line.get_color(), alpha=0.6, label=f"$h^{p}$ (reference)")
     ax.set_xticks(1.0 / np.asarray(ns, dtype=float), [f"1/{n}" for n in ns])
     ax.minorticks_off()
-    ax.set_xlabel("h = 1/n (n elements per side)")
-    ax.set_ylabel(r"$\|\psi - \psi_h\|_{L^2(\Gamma)}$")
-    ax.set_title("Laplace BEM, unit square: Neumann data, u = log|x - x0|")
     ax.invert_xaxis()
-    ax.grid(True, which="both", alpha=0.3)
-    ax.legend(fontsize="small", ncol=2)
+    style_axes(ax, "h = 1/n (n elements per side)", r"$\|\psi - \psi_h\|_{L^2(\Gamma)}$",
+               "Laplace BEM, unit square: Neumann data, u = log|x - x0|",
+               legend=dict(fontsize="small", ncol=2))
     return fig
 
 
@@ -140,13 +132,9 @@ def run(config: dict, quick: bool = False) -> list[ArtefactResult]:
     degrees, ns = prm.degrees, prm.n_per_side
     x0, extra = np.asarray(prm.x0, dtype=float), prm.extra_quadrature_points
 
-    t0 = time.perf_counter()
-    neumann_l2_error(1, 1, x0, extra)  # compile (or load the numba cache) once
-    jit_s = time.perf_counter() - t0
-
-    t_run = time.perf_counter()
-    table = pd.concat([_sweep(p, ns, x0, extra) for p in degrees], ignore_index=True)
-    run_s = time.perf_counter() - t_run
+    jit_s = timed(neumann_l2_error, 1, 1, x0, extra)[1]  # compile (or load the numba cache)
+    table, run_s = timed(lambda: pd.concat([_sweep(p, ns, x0, extra) for p in degrees],
+                                           ignore_index=True))
     claim = replace(joint_claim(
         "L2 error of the Neumann data converges like h^p",
         *(rate_claim("", table[table.p == p].l2_rate.iloc[-1], p, RATE_TOLERANCE,

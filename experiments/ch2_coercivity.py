@@ -14,23 +14,16 @@ are below or above lambda* for p = 1, 2, 3 on the thesis's meshes.
 
 from __future__ import annotations
 
-import logging
 import time
-from dataclasses import dataclass
 
 import numpy as np
 import pandas as pd
 from matplotlib.figure import Figure
 
-from hpfebe.coupling import NitscheFEBE, problem
-from hpfebe.coupling.coercivity import (coercivity_threshold, inverse_constant,
-                                        lemma_2_2_3_bound)
-from hpfebe.suite.params import from_config
-from hpfebe.suite.results import ArtefactResult, Claim, progress
+from hpfebe.scenes import interface
+from hpfebe.suite import ArtefactResult, Claim, from_config, new_figure, progress, style_axes
 
 ARTEFACTS = ("figure_coercivity",)
-
-log = logging.getLogger(__name__)
 
 CHOICES = (
     "alpha = 0, h1 = edge length: the setting that reproduces the thesis's tables.",
@@ -38,57 +31,21 @@ CHOICES = (
     "Lemma bound as printed with gamma = 2 and the computed C_inv of (2.7); young_bound = "
     "C_inv p^(2-alpha) is the sharp version of the lemma's argument.",
 )
-ALPHAS = (0.0, 1.0, 2.0)
+ALPHAS = interface.ALPHAS        # penalty exponents p^alpha
 THESIS_LAMBDAS = (1, 5, 10)      # the lambda_Nit of Example 3
-
-
-@dataclass(frozen=True)
-class Params:
-    degrees: tuple[int, ...] = tuple(range(1, 11))
-    mesh: tuple[int, ...] = (5, 6)                    # [FE h^-1, BE h^-1] of the p-sweep
-    h_pairs: tuple[tuple[int, ...], ...] = ((2, 3), (5, 6), (11, 12))
-    h_def: str = "edge"
-
-    def __post_init__(self):
-        if len(self.mesh) != 2 or any(len(pr) != 2 for pr in self.h_pairs):
-            raise ValueError(f"ch2_coercivity.mesh and h_pairs must be [fe_h_inv, be_h_inv] "
-                             f"pairs, got {self.mesh}, {self.h_pairs}")
-        if not self.degrees or min(self.degrees) < 1:
-            raise ValueError(f"ch2_coercivity.degrees must be >= 1, got {self.degrees}")
+#: the scene's parameters (config section ch2_coercivity)
+Params = interface.CoercivityScene
 
 
 def thresholds(prm: Params) -> pd.DataFrame:
     """lambda*, C_inv and both bounds per p and alpha on the p-sweep mesh; lambda* for
-    p = 1, 2, 3 (alpha = 0) on the other h-version meshes."""
-    pb, (fh, bh) = problem("smooth"), prm.mesh
-    rows = []
-    for p in progress(prm.degrees, desc="coercivity p"):
-        t1 = time.perf_counter()
-        model = NitscheFEBE(pb, fh, bh, p, alpha=0.0, h_def=prm.h_def)
-        star0, C = coercivity_threshold(model), inverse_constant(model)
-        for alpha in ALPHAS:
-            rows.append(dict(mesh=f"{fh}/{bh}", fe_h_inv=fh, be_h_inv=bh, p=p, alpha=alpha,
-                             lambda_star=star0 / p ** alpha, C_inv=C,
-                             young_bound=C * p ** (2 - alpha),
-                             lemma_bound=lemma_2_2_3_bound(p, alpha, C),
-                             wall_time_s=time.perf_counter() - t1))
-        log.info("p=%d: lambda*(alpha=0) = %.4f, C_inv = %.4f", p, star0, C)
-    for fh2, bh2 in prm.h_pairs:
-        for p in (1, 2, 3):
-            if (fh2, bh2) == (fh, bh):
-                continue
-            t1 = time.perf_counter()
-            model = NitscheFEBE(pb, fh2, bh2, p, alpha=0.0, h_def=prm.h_def)
-            rows.append(dict(mesh=f"{fh2}/{bh2}", fe_h_inv=fh2, be_h_inv=bh2, p=p,
-                             alpha=0.0, lambda_star=coercivity_threshold(model),
-                             C_inv=np.nan, young_bound=np.nan, lemma_bound=np.nan,
-                             wall_time_s=time.perf_counter() - t1))
-    return pd.DataFrame(rows)
+    p = 1, 2, 3 (alpha = 0) on the other h-version meshes
+    (:func:`hpfebe.scenes.interface.coercivity_rows`)."""
+    return pd.DataFrame(interface.coercivity_rows(prm, progress))
 
 
 def _figure(main: pd.DataFrame, prm: Params) -> Figure:
-    fig = Figure(figsize=(7.0, 5.0))
-    ax = fig.subplots()
+    fig, ax = new_figure((7.0, 5.0))
     for alpha, c in zip(ALPHAS, ("C0", "C1", "C2")):
         g = main[main.alpha == alpha]
         ax.semilogy(g.p, g.lambda_star, "o-", color=c,
@@ -97,12 +54,9 @@ def _figure(main: pd.DataFrame, prm: Params) -> Figure:
     for value in THESIS_LAMBDAS:
         ax.axhline(value, color="gray", lw=0.6, ls=":")
         ax.annotate(f"lambda={value}", (prm.degrees[-1], value), fontsize=7, color="gray")
-    ax.set_xlabel("p = p1 = p2")
-    ax.set_ylabel("lambda_Nit")
-    ax.set_title(f"Coercivity threshold, Example 1, FE h=1/{prm.mesh[0]}, BE "
-                 f"h=1/{prm.mesh[1]} (h1 = {prm.h_def} length)", fontsize=9)
-    ax.grid(True, which="both", alpha=0.3)
-    ax.legend(fontsize=7)
+    style_axes(ax, "p = p1 = p2", "lambda_Nit", f"Coercivity threshold, Example 1, FE "
+               f"h=1/{prm.mesh[0]}, BE h=1/{prm.mesh[1]} (h1 = {prm.h_def} length)",
+               title_size=9, legend=dict(fontsize=7))
     return fig
 
 

@@ -12,27 +12,27 @@ Figures 2.1 and 2.3: the computed solutions.  Beyond the thesis: error against w
 examples, each run timed ``timing_repeats`` times (the minimum is plotted).  The three
 are independent :data:`SCENES` (Example 1, Example 2, the timed runs).  Rates:
 log(e_prev/e) / log(h_prev/h), for the p-series log(e_prev/e) / log(p/p_prev).  The
-choices where the thesis is silent are :data:`CHOICES`.
+choices where the thesis is silent are :data:`CHOICES`.  The model problems, mesh
+sequences and sweeps: :mod:`hpfebe.scenes.interface`.
 """
 
 from __future__ import annotations
 
 import logging
 import time
-from dataclasses import dataclass, field, replace
-from pathlib import Path
+from dataclasses import replace
 
 import numpy as np
 import pandas as pd
-from matplotlib.figure import Figure
 from matplotlib.tri import Triangulation
 
-from hpfebe.coupling import NitscheFEBE, problem
-from hpfebe.coupling.errors import be_solution_at
-from hpfebe.suite.params import from_config
-from hpfebe.suite.results import ArtefactResult, Claim, joint_claim, rate_claim
+from hpfebe.coupling import NitscheFEBE, be_solution_at
+from hpfebe.scenes import interface
+from hpfebe.suite import (ArtefactResult, Claim, from_config_sections, joint_claim,
+                          new_figure, published_table, rate_claim, reference_slope,
+                          select_scenes, style_axes, timed)
 
-from experiments._ch2 import KEYS, add_slope, compare, last, part_table, sweep
+from experiments._ch2 import KEYS, compare, last, part_table, sweep
 
 ARTEFACTS = ("table_2_1", "table_2_2", "table_2_3", "table_2_4", "figure_2_1", "figure_2_2",
              "figure_2_3", "figure_2_4", "figure_work_precision_ch2")
@@ -65,8 +65,7 @@ CHOICES = (
 
 TOL = {"l2_error": ("factor", 2.0), "h1_error": ("factor", 2.0),
        "l2_rate": ("abs", 0.15), "h1_rate": ("abs", 0.15)}
-TOL_SINGULAR = {"l2_error": ("factor", 2.0), "h1_error": ("factor", 2.0),
-                "l2_rate": ("abs", 0.15), "h1_rate": ("abs", 0.1)}
+TOL_SINGULAR = dict(TOL, h1_rate=("abs", 0.1))
 PUBLISHED = {"table_2_1": "table_2_1_nitsche_smooth_h_BE.csv",
              "table_2_2": "table_2_2_nitsche_smooth_h_FE.csv",
              "table_2_3": "table_2_3_nitsche_singular_BE.csv",
@@ -74,95 +73,14 @@ PUBLISHED = {"table_2_1": "table_2_1_nitsche_smooth_h_BE.csv",
 L2_RATE_NOTE = ("tolerance 0.25 on L2: the thesis's own L2 rates on this non-nested "
                 "sequence scatter by up to 0.5")
 
-
-# ----------------------------------------------------------------------------- parameters
-def _check_pairs(where: str, pairs) -> None:
-    if any(len(pr) != 2 for pr in pairs):
-        raise ValueError(f"{where} must be [fe_h_inv, be_h_inv] pairs, got {pairs}")
-
-
-@dataclass(frozen=True)
-class SmoothParams:
-    h_pairs: tuple[tuple[int, ...], ...] = ((2, 3), (5, 6), (11, 12), (23, 24), (47, 48))
-    degrees: tuple[int, ...] = (1, 2, 3)
-    p_mesh: tuple[int, ...] = (5, 6)
-    p_degrees: tuple[int, ...] = (1, 2, 3, 4, 5, 6, 7, 8)
-    max_fe_h_inv: dict = field(default_factory=dict)   # {p: largest FE h^-1 of the h-version}
-
-    def __post_init__(self):
-        _check_pairs("ch2_convergence.smooth.h_pairs", self.h_pairs)
-        _check_pairs("ch2_convergence.smooth.p_mesh", (self.p_mesh,))
-
-
-@dataclass(frozen=True)
-class SingularParams:
-    h_pairs: tuple[tuple[int, ...], ...] = ((4, 8), (8, 12), (16, 20), (32, 36), (64, 68),
-                                            (128, 132), (256, 260))
-    p_mesh: tuple[int, ...] = (4, 6)
-    p_degrees: tuple[int, ...] = (1, 2, 3, 4, 5, 6, 7)
-
-    def __post_init__(self):
-        _check_pairs("ch2_convergence.singular.h_pairs", self.h_pairs)
-        _check_pairs("ch2_convergence.singular.p_mesh", (self.p_mesh,))
-
-
-@dataclass(frozen=True)
-class Params:
-    lambda_nit: float = 10.0
-    alpha: float = 0.0
-    h_def: str = "edge"
-    smooth: SmoothParams = SmoothParams()
-    singular: SingularParams = SingularParams()
-    timing_repeats: int = 3          # work-precision: the minimum of this many timings
-
-    def __post_init__(self):
-        if self.timing_repeats < 1:
-            raise ValueError(f"ch2_convergence.timing_repeats must be >= 1, got "
-                             f"{self.timing_repeats}")
-
-
-def load_params(config: dict | None) -> Params:
-    """Params from the ch2_convergence section (subsections smooth, singular)."""
-    section = dict(config or {})
-    sm = from_config(SmoothParams, section.pop("smooth", None), scene="ch2_convergence.smooth")
-    sg = from_config(SingularParams, section.pop("singular", None),
-                     scene="ch2_convergence.singular")
-    return replace(from_config(Params, section, scene="ch2_convergence"), smooth=sm,
-                   singular=sg)
+#: the scene's parameters (config section ch2_convergence, subsections smooth, singular)
+SmoothParams, SingularParams, Params = (interface.SmoothParams, interface.SingularParams,
+                                        interface.ConvergenceScene)
+EXAMPLES = interface.EXAMPLES
 
 
 def _published(name: str) -> pd.DataFrame:
-    root = Path(__file__).resolve().parents[1]
-    return pd.read_csv(root / "report" / "published" / PUBLISHED[name], comment="#")
-
-
-# ----------------------------------------------------------------------------- sweeps
-EXAMPLES = ("smooth", "singular")
-
-
-def sweep_cases(prm: Params, example: str) -> dict[str, list[tuple[int, int, int]]]:
-    """The (fe_h_inv, be_h_inv, p) cases of the h- and p-sweep of ``example``."""
-    if example == "smooth":
-        sm = prm.smooth
-        cap = {int(k): v for k, v in sm.max_fe_h_inv.items()}
-        (pf, pb), degrees_h, pairs, p_degrees = sm.p_mesh, sm.degrees, sm.h_pairs, \
-            sm.p_degrees
-    elif example == "singular":
-        sg, cap = prm.singular, {}
-        (pf, pb), degrees_h, pairs, p_degrees = sg.p_mesh, (1,), sg.h_pairs, sg.p_degrees
-    else:
-        raise ValueError(f"example must be one of {EXAMPLES}, got {example!r}")
-    return {"h": [(fh, bh, p) for p in degrees_h for fh, bh in pairs
-                  if fh <= cap.get(p, np.inf)],
-            "p": [(pf, pb, p) for p in p_degrees]}
-
-
-def warm_up(prm: Params) -> float:
-    """Seconds of one small solve: numba compilation or loading of its cache, kept out
-    of the timings."""
-    t0 = time.perf_counter()
-    NitscheFEBE(problem("smooth"), 2, 3, 1).solve(prm.lambda_nit)
-    return time.perf_counter() - t0
+    return published_table(PUBLISHED[name])
 
 
 def example_sweeps(prm: Params, example: str, companions: bool = True
@@ -172,10 +90,9 @@ def example_sweeps(prm: Params, example: str, companions: bool = True
     columns)."""
     kw = dict(lambdas=[prm.lambda_nit], alpha=prm.alpha, h_def=prm.h_def,
               companions=companions)
-    t0 = time.perf_counter()
-    h, p = (sweep(example, series, cases, **kw)
-            for series, cases in sweep_cases(prm, example).items())
-    return h, p, time.perf_counter() - t0
+    (h, p), seconds = timed(lambda: [sweep(example, series, cases, **kw) for series, cases
+                                     in interface.sweep_cases(prm, example).items()])
+    return h, p, seconds
 
 
 def _meta(prm: Params, jit_s: float, **seconds) -> dict:
@@ -358,14 +275,13 @@ def singular_tables(prm: Params, sg_h: pd.DataFrame, sg_p: pd.DataFrame, meta: d
 
 def _solution_figure(name, fe_h, be_h, title, lambda_nit):
     """Computed solution: U1 on the FE mesh (p = 1), I_h u~ of the BE part on Omega2."""
-    pb = problem(name)
+    pb = interface.problem(name)
     model = NitscheFEBE(pb, fe_h, be_h, 1)
     sol = model.solve(lambda_nit)
     m = model.domain.mesh
     d2 = pb.omega2_domain(2 * be_h).mesh
     vals = be_solution_at(model, sol.U2, d2.p.T)
-    fig = Figure(figsize=(6.0, 5.0))
-    ax = fig.subplots()
+    fig, ax = new_figure((6.0, 5.0))
     vmin, vmax = 0.0, float(np.max(sol.U1))
     for mesh, v in ((m, sol.U1[:m.p.shape[1]]), (d2, vals)):
         tri = np.vstack([mesh.t[[0, 1, 2]].T, mesh.t[[0, 2, 3]].T])
@@ -412,8 +328,7 @@ _PARTS = (("be", "h1", "energy-err (BE)"), ("be", "l2", "L2-error (BE)"),
 
 
 def _convergence_figure(h, pv, title, slopes):
-    fig = Figure(figsize=(7.0, 5.0))
-    ax = fig.subplots()
+    fig, ax = new_figure((7.0, 5.0))
     for df, tag, ls, mk in ((h, "h", "-", "o"), (pv, "p", "--", "s")):
         for part, norm, nm in _PARTS:
             ax.loglog(df.dof, df[f"{part}_{norm}"], ls=ls, marker=mk, ms=4,
@@ -421,12 +336,8 @@ def _convergence_figure(h, pv, title, slopes):
         ax.loglog(df.dof, df.be_energy, ls=ls, marker=mk, ms=3, alpha=0.6,
                   label=f"{tag}: trace energy |u-U2|_W (BE)")
     for s, y0, lab in slopes:
-        add_slope(ax, h.dof, y0, s, lab)
-    ax.set_xlabel("DOF")
-    ax.set_ylabel("error")
-    ax.set_title(title, fontsize=9)
-    ax.grid(True, which="both", alpha=0.3)
-    ax.legend(fontsize=6, ncol=2)
+        reference_slope(ax, h.dof, y0, s, lab)
+    style_axes(ax, "DOF", "error", title, title_size=9, legend=dict(fontsize=6, ncol=2))
     return fig
 
 
@@ -481,16 +392,6 @@ def singular_scene(prm: Params, jit_s: float) -> list[ArtefactResult]:
     return tabs + [solution_figure(prm, "singular", meta),
                    singular_figure(prm, sg_h, sg_p, claims_2_4, meta)]
 
-
-def _timed_solve(pb, fe_h, be_h, p, prm: Params) -> tuple[float, float]:
-    """(assembly, solve) seconds of one run, as :func:`lambda_sweep` times them."""
-    t0 = time.perf_counter()
-    model = NitscheFEBE(pb, fe_h, be_h, p, alpha=prm.alpha, h_def=prm.h_def)
-    t1 = time.perf_counter()
-    model.solve(prm.lambda_nit)
-    return t1 - t0, time.perf_counter() - t1
-
-
 def work_precision_sweeps(prm: Params) -> pd.DataFrame:
     """Errors of every case of both examples (one sweep without the companion columns)
     and the minimum over ``timing_repeats`` measurements of assembly, solve and their
@@ -502,9 +403,10 @@ def work_precision_sweeps(prm: Params) -> pd.DataFrame:
         frames += [h, p]
     wp = pd.concat(frames, ignore_index=True)
     asm, sol = [wp.assembly_s.to_numpy()], [wp.solve_s.to_numpy()]
-    pbs = {name: problem(name) for name in EXAMPLES}
+    pbs = {name: interface.problem(name) for name in EXAMPLES}
     for _ in range(prm.timing_repeats - 1):
-        a, s = np.array([_timed_solve(pbs[r.problem], r.fe_h_inv, r.be_h_inv, r.p, prm)
+        a, s = np.array([interface.timed_solve(pbs[r.problem], r.fe_h_inv, r.be_h_inv, r.p,
+                                               prm)
                          for r in wp.itertuples()]).T
         asm.append(a)
         sol.append(s)
@@ -519,20 +421,17 @@ def work_precision(prm: Params, jit_s: float) -> list[ArtefactResult]:
     """Beyond the thesis: FE + BE energy error against wall time (assembly + solve)."""
     t0 = time.perf_counter()
     wp = work_precision_sweeps(prm)
-    fig = Figure(figsize=(10.0, 4.5))
+    fig, axs = new_figure((10.0, 4.5), 1, 2)
     best = {}
-    for ax, name in zip(fig.subplots(1, 2), EXAMPLES):
+    for ax, name in zip(axs, EXAMPLES):
         d = wp[wp.problem == name]
         err = d.fe_h1 + d.be_h1
         for p, g in d[d.series == "h"].groupby("p"):
             ax.loglog(g.wall_time_s, g.fe_h1 + g.be_h1, "o-", ms=3, label=f"h-version p={p}")
         g = d[d.series == "p"]
         ax.loglog(g.wall_time_s, g.fe_h1 + g.be_h1, "s--", ms=3, label="p-version")
-        ax.set_xlabel(f"wall time (assembly + solve) [s], min of {prm.timing_repeats}")
-        ax.set_ylabel("FE + BE energy error")
-        ax.set_title(name, fontsize=9)
-        ax.grid(True, which="both", alpha=0.3)
-        ax.legend(fontsize=7)
+        style_axes(ax, f"wall time (assembly + solve) [s], min of {prm.timing_repeats}",
+                   "FE + BE energy error", name, title_size=9, legend=dict(fontsize=7))
         hit = d[err <= float(err[d.series == "p"].min()) * 3]
         best[name] = hit.sort_values("wall_time_s").iloc[0] if len(hit) else None
     ev = "; ".join(f"{k}: fastest to reach the target error: {v.series}-version p={v.p} "
@@ -566,11 +465,8 @@ SCENE_RUNS = {"smooth": smooth_scene, "singular": singular_scene,
 def run(config: dict, quick: bool = False, scenes=None) -> list[ArtefactResult]:
     """The artefacts of the scenes asked for (None: all; ``quick`` is unused:
     config/quick.yaml sets the sizes)."""
-    prm = load_params(config)
-    scenes = tuple(SCENES) if scenes is None else tuple(scenes)
-    unknown = sorted(set(scenes) - set(SCENES))
-    if unknown:
-        raise ValueError(f"unknown scene(s) {unknown} of ch2_convergence; known: "
-                         f"{list(SCENES)}")
-    jit_s = warm_up(prm)
-    return [r for name in SCENES if name in scenes for r in SCENE_RUNS[name](prm, jit_s)]
+    prm = from_config_sections(Params, config, "ch2_convergence", smooth=SmoothParams,
+                               singular=SingularParams)
+    names = select_scenes(SCENES, scenes, "ch2_convergence")
+    jit_s = interface.warm_up(prm)
+    return [r for name in names for r in SCENE_RUNS[name](prm, jit_s)]

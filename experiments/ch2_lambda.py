@@ -4,12 +4,12 @@ For lambda_Nit in {1, 5, 10, 20}: Example 1 (smooth), h-version p1 = p2 = 1, 2, 
 against the mesh size (Figures 2.5-2.8); Example 2 (singular), h-version p = 1 and p-version
 on FE h^-1 = 4 / BE h^-1 = 6, errors against DOF (Figures 2.9-2.12).  The coupled system of
 each mesh is assembled once and solved for all four lambda_Nit
-(:func:`hpfebe.coupling.errors.lambda_sweep`).  Claims (thesis lines ~3940-4100):
+(:func:`hpfebe.scenes.interface.lambda_sweep`).  Claims (thesis lines ~3940-4100):
 lambda = 1 does not converge for p = 1; lambda = 5 gives a reduced rate for p = 3
 (smooth); the convergence rates for lambda = 10 and 20 are almost the same, "i.e. the
 bilinear form becomes coercive"; singular: the curves do not change from lambda = 5 on.
 How each claim is decided is in :data:`CHOICES`.  Beside the sweeps, the coercivity
-threshold lambda*(p) of every mesh (:func:`hpfebe.coupling.coercivity.coercivity_threshold`)
+threshold lambda*(p) of every mesh (:func:`hpfebe.coupling.coercivity_threshold`)
 tests whether coercivity is what separates the curves that change from those that do
 not.  The two examples are independent :data:`SCENES`.
 """
@@ -17,19 +17,14 @@ not.  The two examples are independent :data:`SCENES`.
 from __future__ import annotations
 
 import logging
-from dataclasses import dataclass
-
 import numpy as np
 import pandas as pd
-from matplotlib.figure import Figure
-from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter
 
-from hpfebe.coupling import NitscheFEBE, problem
-from hpfebe.coupling.coercivity import coercivity_threshold
-from hpfebe.suite.params import from_config
-from hpfebe.suite.results import ArtefactResult, Claim
+from hpfebe.scenes import interface
+from hpfebe.suite import (ArtefactResult, Claim, from_config, new_figure, readable_log_ticks,
+                          reference_slope, select_scenes, style_axes)
 
-from experiments._ch2 import add_slope, rates, sweep
+from experiments._ch2 import rates, sweep
 
 ARTEFACTS = ("figure_2_5", "figure_2_6", "figure_2_7", "figure_2_8", "figure_2_9",
              "figure_2_10", "figure_2_11", "figure_2_12")
@@ -59,29 +54,8 @@ SLOWER = 0.3           # "reduced rate": last energy rate more than 0.3 lower
 RATE_TOL = 0.15        # "almost the same rates": last rates within 0.15
 ERRORS = ("fe_l2", "fe_h1", "be_l2", "be_h1")
 
-
-@dataclass(frozen=True)
-class Params:
-    lambdas: tuple[float, ...] = (1.0, 5.0, 10.0, 20.0)   # lambda_Nit values
-    alpha: float = 0.0
-    h_def: str = "edge"
-    smooth_pairs: tuple[tuple[int, ...], ...] = ((2, 3), (5, 6), (11, 12), (23, 24))
-    degrees: tuple[int, ...] = (1, 2, 3)
-    singular_pairs: tuple[tuple[int, ...], ...] = ((4, 8), (8, 12), (16, 20), (32, 36),
-                                                   (64, 68))
-    singular_p_mesh: tuple[int, ...] = (4, 6)
-    singular_p_degrees: tuple[int, ...] = (1, 2, 3, 4, 5, 6, 7)
-
-    def __post_init__(self):
-        for name in ("smooth_pairs", "singular_pairs"):
-            if any(len(pr) != 2 for pr in getattr(self, name)):
-                raise ValueError(f"ch2_lambda.{name} must be [fe_h_inv, be_h_inv] pairs, "
-                                 f"got {getattr(self, name)}")
-        if len(self.singular_p_mesh) != 2:
-            raise ValueError(f"ch2_lambda.singular_p_mesh must be [fe_h_inv, be_h_inv], "
-                             f"got {self.singular_p_mesh}")
-        if not self.lambdas:
-            raise ValueError("ch2_lambda.lambdas must not be empty")
+#: the scene's parameters (config section ch2_lambda)
+Params = interface.LambdaScene
 
 
 def _last_rate(df, part, x, norm="h1"):
@@ -97,11 +71,8 @@ def _max_rel_diff(a, b, cols=ERRORS):
 
 def thresholds(prm: Params, example: str, cases) -> pd.DataFrame:
     """lambda*(p) (coercivity threshold, Lemma 2.2.3) of every (fe_h_inv, be_h_inv, p) of
-    ``cases``, with the sweep's alpha and h1."""
-    pb = problem(example)
-    return pd.DataFrame([dict(fe_h_inv=fh, be_h_inv=bh, p=p, lambda_star=coercivity_threshold(
-        NitscheFEBE(pb, fh, bh, p, alpha=prm.alpha, h_def=prm.h_def)))
-        for fh, bh, p in cases])
+    ``cases``, with the sweep's alpha and h1 (:func:`.interface.threshold_rows`)."""
+    return pd.DataFrame(interface.threshold_rows(prm, example, cases))
 
 
 def _deviations(d, ref, star) -> pd.DataFrame:
@@ -116,16 +87,6 @@ def _deviations(d, ref, star) -> pd.DataFrame:
 def _points(df) -> str:
     return ", ".join(f"{r.series}-version p={r.p} FE 1/{r.fe_h_inv:g}: {r.dev:.1%} "
                      f"(lambda* {r.lambda_star:.2f})" for r in df.itertuples()) or "none"
-
-
-def _figure(title, xlabel):
-    fig = Figure(figsize=(7.0, 5.0))
-    ax = fig.subplots()
-    ax.set_xlabel(xlabel)
-    ax.set_ylabel("error")
-    ax.set_title(title, fontsize=9)
-    ax.grid(True, which="both", alpha=0.3)
-    return fig, ax
 
 
 #: line styles of the four error curves: (part, norm) -> (label, marker, linestyle)
@@ -202,22 +163,16 @@ def _per_lambda(prm: Params, df: pd.DataFrame, first: int, title: str, xlabel: s
     out = []
     for k, lambda_nit in enumerate(prm.lambdas):
         d = df[df.lambda_nit == lambda_nit]
-        fig, ax = _figure(f"{title}, lambda_Nit = {lambda_nit:g}", xlabel)
+        fig, ax = new_figure((7.0, 5.0))
         draw(ax, d)
-        ax.legend(fontsize=6, ncol=2)
+        style_axes(ax, xlabel, "error", f"{title}, lambda_Nit = {lambda_nit:g}",
+                   title_size=9, legend=dict(fontsize=6, ncol=2))
         out.append(ArtefactResult(
             name=f"figure_2_{first + k}", table=d.reset_index(drop=True), figure=fig,
             claims=claims(lambda_nit, d, ref),
             meta=dict(meta, alpha=prm.alpha, h_def=prm.h_def, lambdas=list(prm.lambdas)),
             notes=notes + " Choices: " + " ".join(CHOICES)))
     return out
-
-
-def _plain_log_ticks(axis) -> None:
-    """Tick labels 2, 5, 10, 20 ... on a log axis spanning about a decade."""
-    axis.set_major_locator(LogLocator(subs=(1.0, 2.0, 5.0)))
-    axis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
-    axis.set_minor_formatter(NullFormatter())
 
 
 def _star_meta(star: pd.DataFrame) -> dict:
@@ -241,8 +196,8 @@ def smooth_figures(prm: Params) -> list[ArtefactResult]:
                 ax.loglog(g[f"{part}_h_inv"], g[f"{part}_{norm}"], color=colours[p],
                           marker=mk, ls=ls, ms=3.5, mfc="none" if part == "be" else None,
                           label=f"{nm}, p={p}")
-            add_slope(ax, g.fe_h_inv, g.fe_h1.iloc[0], -p, f"$h^{p}$")
-        _plain_log_ticks(ax.xaxis)
+            reference_slope(ax, g.fe_h_inv, g.fe_h1.iloc[0], -p, f"$h^{p}$")
+        readable_log_ticks(ax.xaxis)
 
     return _per_lambda(prm, sm, 5, "Example 1, h-version", "1/h", draw,
                        lambda lam, d, ref: _smooth_claims(lam, d, ref, prm.degrees, star),
@@ -316,7 +271,7 @@ def singular_figures(prm: Params) -> list[ArtefactResult]:
                           marker=mk, ms=3.5, mfc="none" if series == "p" else None,
                           label=f"{series}: {nm}")
         gh = d[d.series == "h"].sort_values("dof")
-        add_slope(ax, gh.dof, gh.be_h1.iloc[0], -1 / 3, "DOF$^{-1/3}$", below=True)
+        reference_slope(ax, gh.dof, gh.be_h1.iloc[0], -1 / 3, "DOF$^{-1/3}$", below=True)
 
     return _per_lambda(prm, sg, 9, "Example 2, h- and p-version", "DOF", draw,
                        lambda lam, d, ref: _singular_claims(lam, d, ref, star),
@@ -333,8 +288,5 @@ def run(config: dict, quick: bool = False, scenes=None) -> list[ArtefactResult]:
     """Figures 2.5-2.12 of the scenes asked for (None: both; ``quick`` is unused:
     config/quick.yaml sets the sizes)."""
     prm = from_config(Params, config, scene="ch2_lambda")
-    scenes = tuple(SCENES) if scenes is None else tuple(scenes)
-    unknown = sorted(set(scenes) - set(SCENES))
-    if unknown:
-        raise ValueError(f"unknown scene(s) {unknown} of ch2_lambda; known: {list(SCENES)}")
-    return [r for name in SCENES if name in scenes for r in SCENE_RUNS[name](prm)]
+    return [r for name in select_scenes(SCENES, scenes, "ch2_lambda")
+            for r in SCENE_RUNS[name](prm)]

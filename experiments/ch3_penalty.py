@@ -3,7 +3,7 @@
 Section 3.2.5 (thesis lines 8540-8640).  Omega = [-1,1]^2, Gamma_D = [-1,1] x {1} (u = 0),
 Gamma_C = [-1,1] x {-1}, Gamma_N = the vertical sides (traction free), rigid straight
 obstacle y = -1 + d (d = 2e-4) moving up into the body, E = 266926, nu = 0.29, p = 1 on
-uniform meshes with n elements per side (:func:`hpfebe.contact.limits.square_body`).
+uniform meshes with n elements per side (:mod:`hpfebe.scenes.penalty`).
 Penalty formulation (3.45)-(3.46) with the discrete Steklov-Poincare operator S_hat
 (Section 1.4):
 
@@ -20,22 +20,17 @@ limit, so the absolute value is meant).  The choices where the thesis is silent 
 from __future__ import annotations
 
 import logging
-import math
-import time
-from dataclasses import dataclass, replace
-from pathlib import Path
+from dataclasses import replace
 
 import numpy as np
 import pandas as pd
 from matplotlib.figure import Figure
 from matplotlib.ticker import NullFormatter
 
-from hpfebe.analysis import aitken, energy_norm, observed_rates
-from hpfebe.contact import solve_penalty
-from hpfebe.contact.limits import square_body
-from hpfebe.constitutive.materials import PLANES
-from hpfebe.suite.params import from_config
-from hpfebe.suite.results import ArtefactResult, Claim, progress, rate_claim
+from hpfebe.analysis import aitken, observed_rates
+from hpfebe.scenes import penalty as scene
+from hpfebe.suite import (ArtefactResult, Claim, from_config, new_figure, progress,
+                          published_table, rate_claim, slope_line, style_axes, timed)
 
 ARTEFACTS = ("table_3_1", "figure_3_1")
 
@@ -63,69 +58,8 @@ CHOICES = (
     "finest meshes of the smallest C_eps (shown beside 0.154398); err uses it.",
 )
 
-
-@dataclass(frozen=True)
-class Params:
-    E: float = 266926.0
-    nu: float = 0.29
-    d: float = 2e-4                  # obstacle y = -1 + d, gap g = -d
-    n_per_side: tuple[int, ...] = (4, 8, 16, 32, 64, 128)
-    C_eps: tuple[float, ...] = (1e-4, 1e-5, 1e-6, 1e-7)     # eps = C_eps h
-    planes: tuple[str, ...] = ("strain", "stress")
-    norm_scale: float = math.sqrt(2.0)
-    fixed_eps: tuple[float, ...] = (2.5e-5,)
-    max_newton_iterations: int = 30
-
-    def __post_init__(self):
-        if len(self.n_per_side) < 3 or min(self.n_per_side) < 1:
-            raise ValueError(f"n_per_side needs >= 3 meshes (Aitken) of n >= 1, got "
-                             f"{self.n_per_side}")
-        if not self.C_eps or min(self.C_eps) <= 0:
-            raise ValueError(f"C_eps must be a non-empty list of positive numbers, got "
-                             f"{self.C_eps}")
-        if any(e <= 0 for e in self.fixed_eps):
-            raise ValueError(f"fixed_eps must be positive, got {self.fixed_eps}")
-        if not self.planes or any(pl not in PLANES for pl in self.planes):
-            raise ValueError(f"planes must be a non-empty subset of {PLANES}, got "
-                             f"{self.planes}")
-        if not (self.d > 0 and self.norm_scale > 0):
-            raise ValueError(f"d and norm_scale must be positive, got {self.d}, "
-                             f"{self.norm_scale}")
-        if self.max_newton_iterations < 1:
-            raise ValueError(f"max_newton_iterations must be >= 1, got "
-                             f"{self.max_newton_iterations}")
-
-
-# --------------------------------------------------------------------------- sweep
-def sweep(prm: Params, plane: str) -> pd.DataFrame:
-    """<S_hat U, U>^(1/2) for every (n, C_eps) (S_hat assembled once per mesh), plus the
-    runs with a fixed eps."""
-    rows = []
-    for n in progress(prm.n_per_side, desc=f"plane {plane}"):
-        t0 = time.perf_counter()
-        bem = square_body(n, prm.E, prm.nu, plane)
-        S = bem.S_hat
-        t_asm = time.perf_counter() - t0
-        dof = len(bem.V_space.free_dofs("D", components=2))
-        runs = [(C, C / n, "C_eps h") for C in prm.C_eps] + \
-               [(math.nan, e, "fixed") for e in prm.fixed_eps]
-        for C, eps, kind in runs:
-            t1 = time.perf_counter()
-            res = solve_penalty(bem, eps, -prm.d, S=S, max_iter=prm.max_newton_iterations)
-            wall = time.perf_counter() - t1
-            if not res.converged:
-                raise RuntimeError(f"penalty Newton failed (n={n}, eps={eps}): {res.reason}")
-            rows.append(dict(plane=plane, kind=kind, C_eps=C, n=n, dof=dof, eps=eps,
-                             norm=energy_norm(S, res.U),
-                             newton_iterations=res.iterations,
-                             final_residual=res.residuals[-1],
-                             max_pressure=float(res.pressure_nodes[1].max()),
-                             min_pressure=float(res.pressure_nodes[1].min()),
-                             wall_time_s=wall + (t_asm if C == prm.C_eps[0] else 0.0),
-                             assembly_s=t_asm))
-            log.info("%s n=%d eps=%.3g norm=%.8f it=%d", plane, n, eps, rows[-1]["norm"],
-                     res.iterations)
-    return pd.DataFrame(rows)
+#: the parameters of the scene (config section ch3_penalty)
+Params = scene.PenaltyScene
 
 
 def error_table(data: pd.DataFrame, prm: Params, ulim: dict, best: str) -> pd.DataFrame:
@@ -157,15 +91,10 @@ LINEAR_TOL = 0.15                  # "the linear rate is achieved": rate within 
 LINEAR_TOLS = (0.1, 0.15, 0.2)     # ... and the tolerances the comparison must survive
 
 
-def _published_table() -> pd.DataFrame:
-    f = Path(__file__).resolve().parents[1] / "report" / "published" / PUBLISHED_FILE
-    return pd.read_csv(f, comment="#")
-
-
 def _published_rates(dofs=None) -> dict:
     """Observed rates of the published Table 3.1 per C_eps, from its second mesh on
     (only the rows with DOF in ``dofs``, if given)."""
-    pub = _published_table()
+    pub = published_table(PUBLISHED_FILE)
     if dofs is not None:
         pub = pub[pub.dof.isin(list(dofs))]
     # rates in h = 1/n, n = (dof/2 + 1)/3 elements per side (DOF = 2 (3n - 1))
@@ -203,7 +132,7 @@ def ulim_claim(prm: Params, ulim: dict, best: str) -> Claim:
 def norm_scale_hypothesis(table: pd.DataFrame, prm: Params) -> Claim:
     """The reading that makes ||u_lim||_S and the err column match: the thesis's norms
     are ``norm_scale`` x ours.  A factor read off the published limit, not derived."""
-    pub = _published_table()
+    pub = published_table(PUBLISHED_FILE)
     m = table.merge(pub, on=["C_eps", "dof"], suffixes=("", "_pub"))
     scaled, unscaled = m.err / m.err_pub, m.err_unscaled / m.err_pub
     return Claim(
@@ -313,20 +242,16 @@ def newton_claim(data: pd.DataFrame) -> Claim:
 
 # --------------------------------------------------------------------------- figure
 def figure(table: pd.DataFrame, prm: Params, best: str) -> Figure:
-    fig = Figure(figsize=(6.0, 4.5))
-    ax = fig.subplots()
+    fig, ax = new_figure((6.0, 4.5))
     for C in prm.C_eps:
         sub = table[table.C_eps == C]
         ax.loglog(sub.dof, sub.err, "o-", label=f"$C_\\epsilon$ = {C:g}")
     dref = table.dof.drop_duplicates().sort_values().to_numpy()
     e0 = table[table.C_eps == min(prm.C_eps)].err.iloc[-1]
-    ax.loglog(dref, 1.5 * e0 * dref[-1] / dref, "k--", alpha=0.6, label="slope -1 (h)")
-    ax.set_xlabel("DOF")
+    slope_line(ax, dref, -1.0, (dref[-1], 1.5 * e0), alpha=0.6, label="slope -1 (h)")
     ax.xaxis.set_minor_formatter(NullFormatter())  # overlapping minor-tick labels
-    ax.set_ylabel(r"err$(U^\epsilon)$")
-    ax.set_title(f"Penalty h-BEM, eps = C_eps h (plane {best})")
-    ax.grid(True, which="both", alpha=0.3)
-    ax.legend(fontsize="small")
+    style_axes(ax, "DOF", r"err$(U^\epsilon)$", f"Penalty h-BEM, eps = C_eps h (plane {best})",
+               legend=dict(fontsize="small"))
     return fig
 
 
@@ -334,12 +259,9 @@ def figure(table: pd.DataFrame, prm: Params, best: str) -> Figure:
 def run(config: dict, quick: bool = False) -> list[ArtefactResult]:
     """Table 3.1 and Figure 3.1 (``quick`` is unused: config/quick.yaml sets the sizes)."""
     prm = from_config(Params, config, scene="ch3_penalty")
-    t0 = time.perf_counter()
-    square_body(2, prm.E, prm.nu, "strain").S_hat    # compile (or load the numba cache)
-    jit_s = time.perf_counter() - t0
-    t_run = time.perf_counter()
-    data = pd.concat([sweep(prm, pl) for pl in prm.planes], ignore_index=True)
-    run_s = time.perf_counter() - t_run
+    jit_s = scene.warm_up(prm)  # compile (or load the numba cache)
+    data, run_s = timed(lambda: pd.DataFrame([r for pl in prm.planes
+                                              for r in scene.penalty_sweep(prm, pl, progress)]))
 
     # ||u_lim||_S: Aitken over the three finest meshes of the smallest C_eps, per plane
     Cmin = min(prm.C_eps)

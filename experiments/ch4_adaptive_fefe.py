@@ -1,12 +1,13 @@
 """Figures 4.13-4.16 (Section 4.2.8, thesis lines 14920-15080): adaptive h-refinement for
 FE/FE two-body frictional contact with the penalty method.
 
-Scene (thesis): slave Omega_s = [-1/2, 1/2] x [0, 2] with its top fixed (u_s = 0),
-master Omega_m = [-2, 2] x [-2, 0] with its bottom displaced by u_m = 5e-4 (read as
-(0, 5e-4): upward, both components prescribed), all other boundary parts possible contact
-(in practice the slave's bottom meets the master's top; the slave's sides and the rest of
-the master's top stay open), E = 266926, nu = 0.29, Coulomb mu_f = 0.1.  Solver:
-:class:`hpfebe.contact.two_body.TwoBodyContact` (master-slave projection, penalty normal
+Scene (thesis; :mod:`hpfebe.scenes.adaptive_fefe`): slave Omega_s = [-1/2, 1/2] x [0, 2]
+with its top fixed (u_s = 0), master Omega_m = [-2, 2] x [-2, 0] with its bottom displaced
+by u_m = 5e-4 (read as (0, 5e-4): upward, both components prescribed), all other boundary
+parts possible contact (in practice the slave's bottom meets the master's top; the slave's
+sides and the rest of the master's top stay open), E = 266926, nu = 0.29, Coulomb
+mu_f = 0.1.  Solver: :class:`hpfebe.contact.TwoBodyContact` (master-slave projection,
+penalty normal
 and Coulomb return map, semismooth Newton with load increments, Algorithm 4.1), P1
 triangles in both bodies.  Each body gets its own indicator (3.100) with the contact
 datum on Gamma_C (:func:`hpfebe.adaptivity.two_body_indicators`) and its own marking
@@ -41,36 +42,18 @@ import pandas as pd
 from matplotlib.figure import Figure
 
 from hpfebe.adaptivity import adapt, two_body_indicators
-from hpfebe.analysis.rates import fitted_rate
-from hpfebe.contact.loading import LINEAR_SOLVERS
-from hpfebe.contact.two_body import TwoBodyContact
-from hpfebe.fem import (cell_diameter, distance_to_set, is_conforming, local_mesh_size,
-                        new_vertices, refine_labelled, refinement_concentration)
-from hpfebe.fem.elasticity import ElasticBody, rectangle_mesh
-from hpfebe.constitutive.materials import PLANES
-from hpfebe.scenes.materials import FrictionalContactScene
-from hpfebe.suite.params import from_config
-from hpfebe.suite.results import ArtefactResult, Claim, beats_uniform_claim, progress
+from hpfebe.analysis import fitted_rate
+from hpfebe.contact import LINEAR_SOLVERS, ContactSettings
+from hpfebe.fem import (cell_diameter, is_conforming, local_mesh_size, new_vertices,
+                        refine_labelled, refinement_concentration)
+from hpfebe.io import fe_vtu
+from hpfebe.scenes import adaptive_fefe as scene
+from hpfebe.suite import ArtefactResult, Claim, beats_uniform_claim, from_config, progress
 
 ARTEFACTS = ("figure_4_13", "figure_4_14", "figure_4_15", "figure_4_16")
 NUMBA = False    # FE/FE only: runs beside the job that compiles the numba kernels
 
 log = logging.getLogger(__name__)
-
-BODIES = ("slave", "master")
-BOX = {"slave": (-0.5, 0.5, 0.0, 2.0), "master": (-2.0, 2.0, -2.0, 0.0)}
-#: possible contact boundary of each body (TwoBodyContact), the part that meets the
-#: other body (contact datum of (3.100)) and the open, traction free rest
-CONTACT_BOUNDARY = {"slave": ["bottom", "left", "right"], "master": ["top", "left", "right"]}
-CONTACT = ("bottom", "top")
-OPEN = (("left", "right"), ("left", "right"))
-#: features of the concentration claims: the contact segment and the corners where the
-#: boundary conditions change
-CONTACT_SEGMENT = ((-0.5, 0.0), (0.5, 0.0))
-FEATURE_POINTS = {
-    "slave": [(-0.5, 0.0), (0.5, 0.0), (-0.5, 2.0), (0.5, 2.0)],
-    "master": [(-0.5, 0.0), (0.5, 0.0), (-2.0, -2.0), (2.0, -2.0)],
-}
 
 CHOICES = (
     "Initial meshes: uniform triangulations with h = 1/4 (slave 4 x 8 cells, master 16 x 8 "
@@ -125,12 +108,7 @@ CHOICES = (
 
 
 @dataclass(frozen=True)
-class Params(FrictionalContactScene):
-    u_master: float = 5.0e-4              # master bottom lifted (0, u_master)
-    eps_n_factor: float = 10.0            # 1/eps_n = eps_n_factor E
-    eps_t_factor: float = 5.0             # 1/eps_t = eps_t_factor E
-    slave_cells: tuple[int, ...] = (4, 8)       # h0 = 1/4, 2 triangles per cell
-    master_cells: tuple[int, ...] = (16, 8)
+class Params(scene.FEFEContactScene):
     n_refinements: int = 42
     theta: float = 0.9
     load_steps: int = 5
@@ -147,51 +125,30 @@ class Params(FrictionalContactScene):
     linear_solver: str = "woodbury"       # Newton systems (TwoBodyContact.solve)
 
     def __post_init__(self):
-        if self.plane not in PLANES:
-            raise ValueError(f"plane must be one of {PLANES}, got {self.plane!r}")
-        for name in ("slave_cells", "master_cells"):
-            v = getattr(self, name)
-            if len(v) != 2 or min(v) < 1:
-                raise ValueError(f"{name} must be two positive cell counts, got {v!r}")
+        super().__post_init__()
         for name in ("n_refinements", "load_steps", "max_newton", "max_uniform_steps"):
             if getattr(self, name) < 1:
                 raise ValueError(f"{name} must be >= 1, got {getattr(self, name)!r}")
         for name in ("load_retries", "min_uniform_steps"):
             if getattr(self, name) < 0:
                 raise ValueError(f"{name} must be >= 0, got {getattr(self, name)!r}")
-        for name in ("E", "u_master", "eps_n_factor", "eps_t_factor", "rtol",
-                     "feature_radius", "enrichment", "feature_h_ratio"):
+        for name in ("rtol", "feature_radius", "enrichment", "feature_h_ratio"):
             if not getattr(self, name) > 0:
                 raise ValueError(f"{name} must be positive, got {getattr(self, name)!r}")
         if not 0 < self.theta <= 1 or not 0 <= self.concentration_share <= 1:
             raise ValueError(f"theta must lie in (0, 1] and concentration_share in [0, 1], "
                              f"got {self.theta!r}, {self.concentration_share!r}")
-        if self.mu_f < 0:
-            raise ValueError(f"mu_f must be >= 0, got {self.mu_f!r}")
         if self.linear_solver not in LINEAR_SOLVERS:
             raise ValueError(f"linear_solver must be one of {LINEAR_SOLVERS}, got "
                              f"{self.linear_solver!r}")
 
 
 # --------------------------------------------------------------------------- scene
-def initial_meshes(prm: Params) -> tuple:
-    """Labelled triangulations ("left", "right", "bottom", "top") of both rectangles."""
-    return tuple(rectangle_mesh(*BOX[b], *cells, kind="tri")
-                 for b, cells in zip(BODIES, (prm.slave_cells, prm.master_cells)))
-
-
 def solve_pair(meshes, prm: Params):
     """The two-body problem on the meshes (slave, master): (problem, result)."""
-    S, M = (ElasticBody(m, prm.E, prm.nu, prm.plane) for m in meshes)
-    pr = TwoBodyContact(S, M, CONTACT_BOUNDARY["slave"], CONTACT_BOUNDARY["master"],
-                        eps_n=1.0 / (prm.eps_n_factor * prm.E),
-                        eps_t=1.0 / (prm.eps_t_factor * prm.E), mu_f=prm.mu_f)
-    fixed, is_y = pr.stamp_dofs()
-    n = prm.load_steps
-    res = pr.solve(None, fixed, prm.u_master * is_y, load_factors=np.arange(1, n + 1) / n,
-                   rtol=prm.rtol, max_iter=prm.max_newton, max_cuts=prm.load_retries,
-                   linear_solver=prm.linear_solver)
-    return pr, res
+    return prm.solve(meshes, prm.load_steps, ContactSettings(
+        rtol=prm.rtol, max_iter=prm.max_newton, max_cuts=prm.load_retries,
+        linear_solver=prm.linear_solver))
 
 
 def _solver_columns(pr, res) -> dict:
@@ -216,15 +173,15 @@ def refinement_run(prm: Params, mode: str, n_steps: int, stop=None):
         return (pr, res), (pr.slave.ndofs, pr.master.ndofs)
 
     def estimate(meshes, state):
-        return two_body_indicators(*state, contact=CONTACT, free=OPEN)
+        return two_body_indicators(*state, contact=scene.CONTACT, free=scene.OPEN)
 
-    hist = adapt(initial_meshes(prm), solve, estimate, n_steps + 1, theta=prm.theta,
+    hist = adapt(prm.initial_meshes(), solve, estimate, n_steps + 1, theta=prm.theta,
                  marking="max" if mode == "adaptive" else "uniform", refine=refine_labelled,
                  stop=stop, progress=lambda it: progress(it, desc=f"{mode} refinement"))
     rows = []
     for rec, sol, meshes in zip(hist.records, solver, hist.meshes):
         row = dict(mode=mode, step=rec["step"], **sol)
-        for i, b in enumerate(BODIES):
+        for i, b in enumerate(scene.BODIES):
             row.update({f"dof_{b}": rec["ndof"][i], f"elements_{b}": rec["n_elements"][i],
                         f"eta_{b}": rec["eta"][i],
                         f"h_min_{b}": float(cell_diameter(meshes[i]).min()),
@@ -235,11 +192,6 @@ def refinement_run(prm: Params, mode: str, n_steps: int, stop=None):
 
 
 # --------------------------------------------------------------------------- analysis
-def feature_distance(body: str):
-    """Distance to the features of ``body`` (contact segment and corner points)."""
-    return lambda p: distance_to_set(p, [CONTACT_SEGMENT], FEATURE_POINTS[body])
-
-
 def concentration_table(prm: Params, ad: pd.DataFrame, meshes: list, steps: list):
     """Figure 4.13's table: per shown step the sizes and the share of the new vertices
     near the features; conformity against the initial meshes."""
@@ -252,9 +204,9 @@ def concentration_table(prm: Params, ad: pd.DataFrame, meshes: list, steps: list
                    dof_master=int(ad["dof_master"].iloc[k]),
                    h_min_slave=float(cell_diameter(meshes[k][0]).min()),
                    h_min_master=float(cell_diameter(meshes[k][1]).min()))
-        for b, body in enumerate(BODIES):
+        for b, body in enumerate(scene.BODIES):
             sh = (refinement_concentration(meshes[0][b], meshes[k][b],
-                                           feature_distance(body), r).share if k else 0.0)
+                                           scene.feature_distance(body), r).share if k else 0.0)
             row[f"new_near_features_{body}"] = 0.0 if math.isnan(sh) else sh
         row["conforming"] = all(is_conforming(meshes[k][b], meshes[0][b]) for b in (0, 1))
         rows.append(row)
@@ -265,16 +217,17 @@ def concentration_claims(prm: Params, meshes: list, t13: pd.DataFrame):
     """The two claims of Figure 4.13 (CHOICES) and the feature shares for the meta."""
     r = prm.feature_radius
     ev, shares, conc_ok, most_ok = [], {}, True, True
-    for b, body in enumerate(BODIES):
-        c = refinement_concentration(meshes[0][b], meshes[-1][b], feature_distance(body), r)
-        local = local_mesh_size(meshes[-1][b], FEATURE_POINTS[body])
+    for b, body in enumerate(scene.BODIES):
+        c = refinement_concentration(meshes[0][b], meshes[-1][b],
+                                     scene.feature_distance(body), r)
+        local = local_mesh_size(meshes[-1][b], scene.FEATURE_POINTS[body])
         h0 = float(cell_diameter(meshes[0][b]).max())
         conc_ok &= bool(c.enrichment >= prm.enrichment and
                         all(v <= h0 * prm.feature_h_ratio for v in local))
         most_ok &= bool(c.share >= prm.concentration_share)
         shares[body] = [c.share, c.area_share, c.enrichment]
         loc = ", ".join(f"({x:g},{y:g}): h {v:.3g}"
-                        for (x, y), v in zip(FEATURE_POINTS[body], local))
+                        for (x, y), v in zip(scene.FEATURE_POINTS[body], local))
         ev.append(f"{body}: {c.n_new} new vertices, {100 * c.share:.1f}% of them within {r} "
                   f"of the features, a neighbourhood of {100 * c.area_share:.1f}% of the "
                   f"area (density {c.enrichment:.1f}x the mean); local h at the feature "
@@ -309,15 +262,15 @@ def wider_reading_claim(prm: Params, meshes: list) -> Claim:
     neighbourhood still holds them at >= enrichment x the mean density (else "most"
     would hold for a uniform refinement too)."""
     ok, ev = [], []
-    for b, body in enumerate(BODIES):
+    for b, body in enumerate(scene.BODIES):
         new = new_vertices(meshes[0][b], meshes[-1][b])
-        d = feature_distance(body)(meshes[-1][b].p[:, new])
+        d = scene.feature_distance(body)(meshes[-1][b].p[:, new])
         if not new.any():
             ok.append(None)
             ev.append(f"{body}: no new vertices")
             continue
         r_half = float(np.quantile(d, prm.concentration_share, method="higher"))
-        c = refinement_concentration(meshes[0][b], meshes[-1][b], feature_distance(body),
+        c = refinement_concentration(meshes[0][b], meshes[-1][b], scene.feature_distance(body),
                                      r_half)
         ok.append(bool(c.enrichment >= prm.enrichment))
         ev.append(f"{body}: {100 * c.share:.1f}% of the new vertices within r = "
@@ -337,10 +290,8 @@ def wider_reading_claim(prm: Params, meshes: list) -> Claim:
 def vtu_meshes(tag, pr, res, etas) -> dict:
     """{f"{tag}_{body}": meshio.Mesh} of both bodies with the displacement and the
     indicator (max over the elements at each vertex), for ArtefactResult.exports."""
-    from hpfebe.io.vtu import fe_vtu
-
     out = {}
-    for name, body, u, eta in zip(BODIES, (pr.slave, pr.master),
+    for name, body, u, eta in zip(scene.BODIES, (pr.slave, pr.master),
                                   (res.u_slave, res.u_master), etas):
         ev = np.zeros(body.mesh.p.shape[1])
         for i in range(3):
@@ -490,7 +441,7 @@ def decay_result(body, fig_id, fig_no, ad, un, notes, meta) -> ArtefactResult:
 def figure_4_16(prm, hist, exports, notes, meta) -> ArtefactResult:
     pr, res = hist.state
     rows = []
-    for body, b, u in zip(BODIES, (pr.slave, pr.master), (res.u_slave, res.u_master)):
+    for body, b, u in zip(scene.BODIES, (pr.slave, pr.master), (res.u_slave, res.u_master)):
         un_ = b.nodal_displacement(u)
         rows.append(dict(body=body, dof=b.ndofs, ux_min=float(un_[0].min()),
                          ux_max=float(un_[0].max()), uy_min=float(un_[1].min()),

@@ -28,8 +28,9 @@
 # HPFEBE_SLURM_CONF_EXTRA (lines appended to slurm.conf),
 # HPFEBE_SLURM_KEEP_LOGS=1 (keep SLURM's per-job logs in REPO/.snakemake/slurm_logs),
 # HPFEBE_SLURM_ORPHAN_CHECK=1 (before step 3: start the workflow, kill -9 the main
-# Snakemake while jobs run, check that no job writes or removes a result file after it;
-# needs the Snakefile's job watch for cluster runs; ~40 s).
+# Snakemake while jobs run, check that no job writes or removes a result file after it:
+# the job watch, and the parent check before every rename of a result,
+# hpfebe.suite.watch.before_rename; ~1-2 min).
 set -euo pipefail
 
 SCRIPT_DIR="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"

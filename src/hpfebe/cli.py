@@ -13,12 +13,13 @@ import json
 import logging
 import os
 import re
-import signal
 import sys
 import time
 from pathlib import Path
 
-from .suite.results import published_file_for
+from .suite.published import published_file_for
+from .suite.watch import (ParentGone, Terminated, install_signal_handlers,
+                          watch_parent_from_env)
 
 log = logging.getLogger("hpfebe")
 
@@ -94,172 +95,7 @@ class JitTimer:
         return {"jit_compile_s": round(self.compile_s, 3), "jit_s": round(self.jit_s, 3)}
 
 
-# --------------------------------------------------------------------------- signals
-#: environment variables naming the Snakemake whose death stops a run (set by the
-#: Snakefile in the main Snakemake; a cluster job inherits them through the nested
-#: Snakemakes that run it): its process id, its host, and (cluster runs) the heartbeat
-#: file it rewrites every second, watched by a job on another host
-PARENT_PID_ENV = "HPFEBE_PARENT_PID"
-PARENT_HOST_ENV = "HPFEBE_PARENT_HOST"
-HEARTBEAT_ENV = "HPFEBE_HEARTBEAT"
-#: seconds without a change of the heartbeat file after which its Snakemake is taken for
-#: dead (it is rewritten every second; a shared file system may show a change late)
-HEARTBEAT_TIMEOUT_S = 10.0
-
-
-class Terminated(BaseException):
-    """Raised in the main thread by the SIGTERM/SIGHUP handler (a BaseException, like
-    KeyboardInterrupt, so that no ``except Exception`` swallows it); exit 128 + signum."""
-
-    def __init__(self, signum: int, why: str = ""):
-        super().__init__(signum)
-        self.signum, self.why = signum, why
-
-
-def _on_signal(signum, frame):  # noqa: ARG001 - signal handler signature
-    from .suite.results import remove_temporaries
-
-    remove_temporaries()
-    raise Terminated(signum)
-
-
-def install_signal_handlers() -> None:
-    """SIGTERM and SIGHUP end a run like Ctrl-C does: the temporary files of atomic
-    writes in progress are removed, no result file is left half written, and the exit
-    status is 128 + signal number.  (SIGINT raises KeyboardInterrupt, which
-    :func:`hpfebe.suite.results.atomic_write` cleans up the same way; exit 130.)"""
-    for sig in (signal.SIGTERM, getattr(signal, "SIGHUP", None)):
-        if sig is not None:
-            signal.signal(sig, _on_signal)
-
-
-def _start_time(pid: int) -> str | None:
-    """Start time of process ``pid`` (Linux /proc), to tell it from a reused pid."""
-    try:
-        with open(f"/proc/{pid}/stat", encoding="ascii", errors="replace") as f:
-            fields = f.read().rsplit(")", 1)[1].split()
-        return None if fields[0] in ("Z", "X") else fields[19]
-    except (OSError, IndexError):
-        return None
-
-
-def _alive(pid: int, start: str | None) -> bool:
-    if start is not None:                         # Linux: same process, not a zombie
-        return _start_time(pid) == start
-    try:
-        os.kill(pid, 0)
-    except ProcessLookupError:
-        return False
-    except PermissionError:
-        return True
-    return True
-
-
-def _stop_when(gone, why: str, interval: float, grace: float):
-    """A daemon thread that polls ``gone()`` every ``interval`` seconds and, when it is
-    true, sends this process SIGTERM (see :func:`install_signal_handlers`); if the main
-    thread has not ended ``grace`` seconds later (stuck in compiled code), the
-    temporaries are removed and the process exits hard with status 143."""
-    import threading
-
-    def loop():
-        while not gone():
-            time.sleep(interval)
-        log.warning("%s: stopping this run", why)
-        os.kill(os.getpid(), signal.SIGTERM)
-        time.sleep(grace)
-        from .suite.results import remove_temporaries
-
-        remove_temporaries()
-        os._exit(128 + signal.SIGTERM)
-
-    t = threading.Thread(target=loop, name="hpfebe-watch-parent", daemon=True)
-    t.start()
-    return t
-
-
-def watch_parent(pid: int, interval: float = 1.0, grace: float = 30.0):
-    """Stop this run when process ``pid`` ends (Snakemake killed, even by SIGKILL, must
-    not leave its jobs running on as orphans writing into results/); see
-    :func:`_stop_when`.  Returns the thread; CLIError if ``pid`` is not running now (its
-    Snakemake ended before this job started)."""
-    start = _start_time(pid)
-    if not _alive(pid, start):
-        raise CLIError(f"{PARENT_PID_ENV}={pid} names a process that has ended: the "
-                       "Snakemake that started this job is gone, so the job does not run "
-                       f"(to run the command by hand, leave out {PARENT_PID_ENV})")
-    return _stop_when(lambda: not _alive(pid, start), f"parent process {pid} is gone",
-                      interval, grace)
-
-
-def _heartbeat_state(path: Path):
-    """What changes at each heartbeat: the file's content and mtime (the content is read,
-    not only stat'ed: opening a file revalidates NFS's cached attributes)."""
-    try:
-        with open(path, "rb") as f:
-            return f.read(64), os.fstat(f.fileno()).st_mtime_ns
-    except OSError:
-        return None
-
-
-def watch_heartbeat(path: Path, timeout: float = HEARTBEAT_TIMEOUT_S,
-                    interval: float = 1.0, grace: float = 30.0):
-    """Stop this run when the heartbeat file ``path`` has not changed for ``timeout``
-    seconds (by this host's clock): the Snakemake on another host that rewrites it every
-    second is gone.  CLIError if the file is missing or was last written more than
-    ``timeout`` seconds ago (by the file server's clock) when the job starts."""
-    path = Path(path)
-    try:
-        age = time.time() - path.stat().st_mtime
-    except OSError:
-        age = None
-    if age is None or age > timeout:
-        raise CLIError(f"{HEARTBEAT_ENV}={path} is " + ("missing" if age is None else
-                       f"{age:.0f} s old") + ": the Snakemake that started this job is "
-                       f"gone, so the job does not run (to run the command by hand, leave "
-                       f"out {PARENT_PID_ENV})")
-    last = [_heartbeat_state(path), time.monotonic()]
-
-    def gone():
-        state = _heartbeat_state(path)
-        if state is not None and state != last[0]:
-            last[:] = [state, time.monotonic()]
-        return time.monotonic() - last[1] > timeout
-
-    return _stop_when(gone, f"the heartbeat {path} stopped {timeout:.0f} s ago",
-                      interval, grace)
-
-
-def _watch_parent_from_env() -> None:
-    """The job watch: the parent Snakemake's pid where it runs on this host (the local
-    executor; a cluster job on the submit host), else its heartbeat file (a cluster job
-    on another node; the file is on the file system shared with it)."""
-    import socket
-
-    value = os.environ.get(PARENT_PID_ENV)
-    if not value:
-        return
-    try:
-        pid = int(value)
-    except ValueError:
-        log.warning("%s=%r is not a process id; ignored", PARENT_PID_ENV, value)
-        return
-    host = os.environ.get(PARENT_HOST_ENV)
-    if host and host != socket.gethostname():
-        heartbeat = os.environ.get(HEARTBEAT_ENV)
-        if heartbeat:
-            watch_heartbeat(Path(heartbeat))
-            log.info("this run stops when %s (the heartbeat of the Snakemake that started "
-                     "it, on %s) stops", heartbeat, host)
-        else:
-            log.warning("the Snakemake that started this job runs on %s and writes no "
-                        "heartbeat (%s): this job is not watched", host, HEARTBEAT_ENV)
-        return
-    if pid > 1 and pid != os.getpid():
-        watch_parent(pid)
-        log.info("this run stops when process %d (the Snakemake that started it) ends", pid)
-
-
+# --------------------------------------------------------------------------- interrupted runs
 def remove_stale_temporaries(out: Path, artefacts) -> list[Path]:
     """Temporary files ``.<artefact>.<ext>.*.tmp`` left in ``out`` by a run that was
     killed outright (SIGKILL: no handler can clean up); removed before a new run of the
@@ -268,7 +104,7 @@ def remove_stale_temporaries(out: Path, artefacts) -> list[Path]:
     if out.is_dir():
         for a in artefacts:
             stale += [p for p in out.glob(f".{a}.*.tmp") if p.is_file()]
-            stale += [p for p in out.glob(f".{a}_*.vtu") if p.is_file()]   # export.write_vtu
+            stale += [p for p in out.glob(f".{a}_*.vtu") if p.is_file()]   # io.vtu.write_vtu
     for p in stale:
         try:
             p.unlink()
@@ -663,9 +499,9 @@ def main(argv: list[str] | None = None) -> int:
         return EXIT_USAGE
     install_signal_handlers()
     try:
-        _watch_parent_from_env()
+        watch_parent_from_env()
         return args.func(args)
-    except CLIError as exc:
+    except (CLIError, ParentGone) as exc:
         print(f"hpfebe: error: {exc}", file=sys.stderr)
         return EXIT_USAGE
     except KeyboardInterrupt:
@@ -675,8 +511,9 @@ def main(argv: list[str] | None = None) -> int:
         print("hpfebe: interrupted (no result file was left half written)", file=sys.stderr)
         return 130
     except Terminated as exc:
-        print(f"hpfebe: terminated by signal {exc.signum} (no result file was left half "
-              "written)", file=sys.stderr)
+        why = f": {exc.why}" if exc.why else ""
+        print(f"hpfebe: terminated by signal {exc.signum}{why} (no result file was left "
+              "half written)", file=sys.stderr)
         return 128 + exc.signum
     except Exception:
         log.exception("hpfebe %s failed", args.command)

@@ -19,6 +19,8 @@ from functools import lru_cache
 import numpy as np
 from numpy.polynomial import legendre as npleg
 
+__all__ = ["gauss_legendre", "gauss_lobatto", "gauss_log", "rule_tables"]
+
 
 def _check_n(n: int, name: str = "n", minimum: int = 1) -> int:
     if int(n) != n or n < minimum:

@@ -33,6 +33,10 @@ from numpy.polynomial import legendre as npleg
 from .geometry import BoundaryMesh
 from .quadrature import gauss_legendre, gauss_lobatto
 
+__all__ = ["ContinuousSpace", "DiscontinuousSpace", "prolongate", "containing_elements",
+           "lagrange_values", "legendre_values", "gll_tables", "eval_basis", "n_local",
+           "P_MAX", "LEGENDRE", "LAGRANGE_GLL"]
+
 P_MAX = 24  # largest supported polynomial degree
 
 LEGENDRE, LAGRANGE_GLL = 0, 1  # basis kinds understood by the numba kernels

@@ -97,7 +97,8 @@ def test_several_meshes_validation():
 
 
 def test_one_mesh_records_marked_elements():
-    """The call of experiments/ch3_adaptive_bem.py (one BoundaryMesh) and its history."""
+    """The call of experiments/ch3_adaptive_bem (one BoundaryMesh,
+    hpfebe.scenes.adaptive_bem.adaptive_run) and its history."""
     mesh = BoundaryMesh.polygon([(0, 0), (1, 0), (1, 1), (0, 1)], n=2, p=1)
 
     def estimate(m, s):

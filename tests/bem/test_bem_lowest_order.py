@@ -10,14 +10,8 @@ import pytest
 
 from hpfebe import BoundaryMesh
 from hpfebe.bem import LaplaceBEM
-from hpfebe.bem.lowest_order import (
-    N_SERIES,
-    Q_NEAR,
-    _pair_far,
-    _pair_near,
-    applies,
-    laplace_p1_vk,
-)
+from hpfebe.bem.lowest_order import applies, laplace_p1_vk
+from hpfebe.bem.lowest_order_pairs import N_SERIES, Q_NEAR, _pair_far, _pair_near
 
 from p1_meshes import MESHES as ALL_MESHES
 from p1_meshes import SQUARE, graded, rel

@@ -1,4 +1,4 @@
-"""Closed-form lowest-order Lame V, K, W (hpfebe.bem.lowest_order.lame_p1, issue 14).
+"""Closed-form lowest-order Lame V, K, W (hpfebe.bem.lowest_order_lame.lame_p1, issue 14).
 
 Reference: the general quadrature path (``LameBEM(..., closed_form=False)``); the Guenter
 representation (L2) of the double layer checked on the quadrature matrices alone (p = 2);
@@ -12,11 +12,8 @@ import pytest
 from hpfebe import BoundaryMesh
 from hpfebe.bem import LameBEM, LaplaceBEM
 from hpfebe.bem.lame import kernel_params
-from hpfebe.bem.lowest_order import (
-    _p1_pass,
-    lame_p1,
-    lame_p1_w,
-)
+from hpfebe.bem.lowest_order import _p1_pass
+from hpfebe.bem.lowest_order_lame import lame_p1, lame_p1_w
 from p1_meshes import MESHES, SQUARE, graded, ngon, rel, star
 
 # (E, nu, plane, scale); scale None: the default 2 x diameter

@@ -4,7 +4,8 @@ pyproject.toml; run with ``pytest tests/benchmarks/test_bench_mortar.py
 
 import numpy as np
 
-from hpfebe.contact.mortar import model_meshes, model_problem, projected_cg
+from hpfebe.scenes import model_meshes, model_problem
+from hpfebe.solvers import DtNSettings, projected_cg
 from hpfebe.coupling.mortar import MortarProjection
 
 
@@ -20,7 +21,7 @@ def test_bench_dtn_solve(benchmark):
     Table 4.1 meshes; S_hat and the Schur complements assembled once outside the
     timing."""
     pr = model_problem()
-    benchmark(lambda: pr.dtn(0.7, 0.5))
+    benchmark(lambda: pr.dtn(DtNSettings(0.7, 0.5)))
 
 
 def test_bench_dtn_table_reading(benchmark):
@@ -28,8 +29,8 @@ def test_bench_dtn_table_reading(benchmark):
     DtN pressure, function transfer): (omega_D, omega_N) = (0.5, 0.5), 23 DtN and
     ~11700 Uzawa iterations."""
     pr = model_problem()
-    benchmark.pedantic(lambda: pr.dtn(0.5, 0.5, friction="coulomb", transfer="function"),
-                       rounds=3, iterations=1)
+    settings = DtNSettings(0.5, 0.5, transfer="function")
+    benchmark.pedantic(lambda: pr.dtn(settings, friction="coulomb"), rounds=3, iterations=1)
 
 
 def test_bench_projected_cg(benchmark):

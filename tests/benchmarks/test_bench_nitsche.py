@@ -7,7 +7,8 @@ stiffness, S_hat, the interface terms on the common refinement and the right-han
 
 import pytest
 
-from hpfebe.coupling import SMOOTH, NitscheFEBE
+from hpfebe.coupling import NitscheFEBE
+from hpfebe.scenes.interface import SMOOTH
 
 
 @pytest.fixture(scope="module")

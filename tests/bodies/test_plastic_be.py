@@ -12,7 +12,7 @@ from hpfebe.fem.newton_potential import CellComplex
 from hpfebe.fem.plastic_body import DisplacementSteps, ElastoPlasticFE
 from hpfebe.constitutive.j2 import J2Material, J2State, return_map, tensor_norm
 from hpfebe.geometry import BoundaryMesh
-from hpfebe.solvers.nonlinear import load_path
+from hpfebe.solvers import load_path
 from hpfebe.bodies.plastic_be import DirichletSolver, ElastoPlasticBE, staggered_path
 
 MAT = J2Material(1000.0, 0.3, 1.0, 200.0, 1.0)
@@ -244,7 +244,7 @@ def test_rectangle_work_piece_in_two_body_contact():
     """An elastic BE stamp pressed onto a BE work piece (Example 2 geometry, coarse,
     moderate hardening) with TwoBodyContact: converges, the plastic zone is under the
     stamp, the bottom reaction is in equilibrium with the contact force."""
-    from hpfebe.contact.two_body import TwoBodyContact
+    from hpfebe.contact import ContactSettings, TwoBodyContact
     from hpfebe.scenes import stamp_body
     from hpfebe.bodies.plastic_be import PlasticBEBody, rectangle_work_piece
     mat = J2Material(1000.0, 0.3, 1.0, 200.0, 1.0)
@@ -254,8 +254,7 @@ def test_rectangle_work_piece_in_two_body_contact():
     pr = TwoBodyContact(stamp, body, "bottom", "top", eps_n=1 / (10 * mat.E),
                         eps_t=1 / (5 * mat.E), mu_f=0.2)
     fixed, is_y = pr.stamp_dofs()
-    res = pr.solve(None, fixed, 4e-3 * is_y, load_factors=np.linspace(0.25, 1, 4), rtol=1e-8,
-                   max_iter=40, line_search=True)
+    res = pr.solve(None, fixed, 4e-3 * is_y, load_factors=np.linspace(0.25, 1, 4), settings=ContactSettings(rtol=1e-8, max_iter=40, line_search=True))
     assert res.converged
     assert be.plastic.any()
     assert be.cells.centroids[be.plastic][:, 1].max() > -1.6     # near the contact

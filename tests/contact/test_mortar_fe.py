@@ -1,14 +1,16 @@
 """The mortar FE/FE contact with an elastoplastic work piece (hpfebe.contact.mortar_fe,
-Section 4.4): the DtN algorithm (Algorithm 4.3 with the elastoplastic Neumann problem)
-converges to the solution of the monolithic semismooth Newton method on a small version
-of the scene; non-convergence of DtN is detected for a diverging damping pair."""
+Section 4.4, the scene of hpfebe.scenes.section44): the DtN algorithm (Algorithm 4.3
+with the elastoplastic Neumann problem) converges to the solution of the monolithic
+semismooth Newton method on a small version of the scene; non-convergence of DtN is
+detected for a diverging damping pair."""
 
 import numpy as np
 import pytest
 
-from hpfebe.contact.mortar_fe import (READINGS, FEMortarContact, fe_trace_mesh,
-                                      section44_scene)
-from hpfebe.fem.elasticity import rectangle_mesh
+from hpfebe.contact import NeumannSettings
+from hpfebe.contact.mortar_fe import FEMortarContact, fe_trace_mesh
+from hpfebe.fem import rectangle_mesh
+from hpfebe.scenes import READINGS, DtNReadings, dtn_settings, section44_scene
 
 
 @pytest.fixture(scope="module")
@@ -25,7 +27,7 @@ def mono(scene):
 
 
 def test_dtn_matches_monolithic(scene, mono):
-    sol = scene.dtn(0.5, 0.5, tol=1e-10, newton_tol=1e-10)
+    sol = scene.dtn(dtn_settings(0.5, 0.5, tol=1e-10), NeumannSettings(1e-10))
     assert sol.info.converged, sol.info.reason
     # the work piece yields: the problem is elastoplastic
     assert sol.extra["fields"]["eps_p_norm_mean"].max() > 0
@@ -44,16 +46,18 @@ def test_dtn_matches_monolithic(scene, mono):
 
 def test_dtn_default_tolerances_close_to_monolithic(scene, mono):
     """TOL_DtN = 1e-6 (the thesis's): U2 within 1e-5 of the monolithic solution."""
-    sol = scene.dtn(0.5, 0.7)
+    readings = DtNReadings(scene)
+    sol = scene.dtn(dtn_settings(0.5, 0.7), hook=readings)
     assert sol.info.converged, sol.info.reason
     assert np.abs(sol.extra["u2"] - mono.extra["u2"]).max() <= \
         1e-5 * np.abs(mono.extra["u2"]).max()
     # Uzawa: several iterations in the first DtN iteration, then at most 2
     uz = [s.counts["uzawa"] for s in sol.info.steps]
     assert uz[0] >= 2 and max(uz[1:]) <= 2
-    # every reading of the stopping rule recorded per iteration; the fixed_point stop
-    # (relative to the new P) and the printed one (relative to the previous P) agree
-    rd = sol.info.counts["readings"]
+    # every reading of the stopping rule recorded per iteration by the hook; the
+    # fixed_point stop (relative to the new P) and the printed one (relative to the
+    # previous P) agree
+    rd = readings.values
     assert set(rd) == set(READINGS)
     assert all(len(v) == sol.info.iterations for v in rd.values())
     assert np.allclose(rd["P_l2_new"], sol.info.counts["relative_increments"])
@@ -67,12 +71,13 @@ def test_tangential_increments_contract_by_one_minus_omega_N(scene, omega_N):
     """Where the stamp slides, step 6 relaxes the tangential traction alone: the
     tangential part of P^k - P^k-1 shrinks by exactly 1 - omega_N per DtN iteration,
     whatever omega_D does, and bounds the printed stopping rule from below."""
-    sol = scene.dtn(0.5, omega_N, tol=1e-8)
+    readings = DtNReadings(scene)
+    sol = scene.dtn(dtn_settings(0.5, omega_N, tol=1e-8), hook=readings)
     assert sol.info.converged, sol.info.reason
     # every contact node slides (|lambda| = 1) but the middle one (x = 0, symmetry)
     lam = np.abs(sol.lam)
     assert np.all((lam >= 1 - 1e-12) | (lam <= 1e-9)) and np.sum(lam <= 1e-9) == 1
-    rd = sol.info.counts["readings"]
+    rd = readings.values
     t = np.asarray(rd["P_t_l2_prev"])[1:]
     a = (t * np.asarray(sol.info.counts["P_norms"])[: t.size])[t > 1e-9]
     assert a.size >= 4
@@ -84,7 +89,7 @@ def test_non_yielding_work_piece_is_solved():
     """sigma_Y far beyond the small-strain range (an elastic work piece): the Newton
     floor must not accept an undeformed work piece (it did with sigma_Y x h as floor)."""
     sc = section44_scene((4, 8), (16, 8), sigma_Y=4e12, formulation="full")
-    sol = sc.dtn(0.5, 0.7)
+    sol = sc.dtn(dtn_settings(0.5, 0.7))
     assert sol.info.converged, sol.info.reason
     assert sc.kkt_residual(sol)["equilibrium2"] <= 1e-7
     assert sol.extra["fields"]["eps_p_norm_mean"].max() == 0
@@ -92,7 +97,7 @@ def test_non_yielding_work_piece_is_solved():
 
 
 def test_divergence_detected(scene):
-    sol = scene.dtn(0.9, 1.0, max_iter=30)
+    sol = scene.dtn(dtn_settings(0.9, 1.0, max_iter=30))
     assert not sol.info.converged
     assert sol.info.reason.startswith(("max_iter", "diverged", "inner solve",
                                        "no solution"))
@@ -101,11 +106,13 @@ def test_divergence_detected(scene):
 
 def test_bad_input(scene):
     with pytest.raises(ValueError, match="omega_D"):
-        scene.dtn(0.0, 0.5)
+        dtn_settings(0.0, 0.5)
     with pytest.raises(ValueError, match="omega_N"):
-        scene.dtn(0.5, 1.5)
+        dtn_settings(0.5, 1.5)
     with pytest.raises(ValueError, match="rho"):
-        scene.dtn(0.5, 0.5, rho=-1.0)
+        dtn_settings(0.5, 0.5, rho=-1.0)
+    with pytest.raises(ValueError, match="newton tol"):
+        NeumannSettings(tol=0.0)
     with pytest.raises(ValueError, match="F"):
         FEMortarContact(scene.stamp, scene.work, ("top", (0, 0)), ("bottom", (0, 1e-4)),
                         -1.0)
@@ -128,16 +135,17 @@ def test_trace_mesh_vertices():
 def test_stamp_condensed_once(scene, monkeypatch):
     """The stamp's Schur complement is built with the scene and reused by every DtN run
     (no CondensedBody, no new Cholesky factorisation of the stamp, per damping pair)."""
-    import hpfebe.contact.mortar as mortar
+    import hpfebe.bodies.condensed as condensed
+    import hpfebe.contact.mortar_fe as mortar_fe
 
     def refactorised(*args, **kwargs):
         raise AssertionError("the stamp was factorised again")
 
-    monkeypatch.setattr(mortar.sla, "cho_factor", refactorised)
-    monkeypatch.setattr(mortar, "CondensedBody", refactorised)
+    monkeypatch.setattr(condensed.sla, "cho_factor", refactorised)
+    monkeypatch.setattr(mortar_fe, "CondensedBody", refactorised)
     body1 = scene.body1
     for pair in ((0.5, 0.7), (0.7, 0.5)):
-        assert scene.dtn(*pair).info.converged
+        assert scene.dtn(dtn_settings(*pair)).info.converged
     assert scene.body1 is body1
 
 

@@ -14,9 +14,10 @@ from hpfebe.bem.lame import LameBEM
 from hpfebe.contact import solve_penalty
 from hpfebe.contact.limits import (MACHEPS, backward_error, check_penalty_solution,
                                    constrained_limit, saturation_index, singular_exponent,
-                                   solve_penalty_checked, square_body)
+                                   solve_penalty_checked)
 from hpfebe.contact.penalty import penalty_residual
 from hpfebe.geometry import BoundaryMesh
+from hpfebe.scenes.penalty import square_body
 
 E, NU, D = 266926.0, 0.29, 2e-4
 

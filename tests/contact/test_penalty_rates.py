@@ -13,9 +13,9 @@ import pytest
 
 from hpfebe.analysis import aitken, energy_norm, observed_rates
 from hpfebe.contact import solve_penalty
-from hpfebe.contact.limits import (MACHEPS, constrained_limit, solve_penalty_checked,
-                                   square_body)
+from hpfebe.contact.limits import MACHEPS, constrained_limit, solve_penalty_checked
 from hpfebe.contact.penalty import penalty_residual
+from hpfebe.scenes.penalty import square_body
 from hpfebe.spaces import prolongate
 
 E, NU, D = 266926.0, 0.29, 2e-4

@@ -21,7 +21,9 @@ import dataclasses
 import numpy as np
 import pytest
 
-from hpfebe.contact.two_body import OPEN, SLIP, STICK, TwoBodyContact, project_onto_polyline
+from hpfebe.constitutive import OPEN, SLIP, STICK
+from hpfebe.contact import ContactSettings, TwoBodyContact
+from hpfebe.contact.points import project_onto_polyline
 from hpfebe.fem.elasticity import ElasticBody, rectangle_mesh
 
 E, NU = 266926.0, 0.29
@@ -213,7 +215,7 @@ def test_inconsistent_tangent_is_detected_by_the_newton_test():
 
     pr, fixed, values = punch()
     pr.__class__ = NoCoupling
-    res = pr.solve(None, fixed, values, load_factors=np.linspace(0.25, 2.0, 8), max_iter=60)
+    res = pr.solve(None, fixed, values, load_factors=np.linspace(0.25, 2.0, 8), settings=ContactSettings(max_iter=60))
     multi = [st.residuals for st in res.steps if st.iterations >= 2]
     # measured: 9 and 10 iterations in the shear steps, linear rate ~0.1
     assert (not res.converged) or (max(res.iterations) > 4 and not all(
@@ -245,7 +247,7 @@ def test_tangent_matches_finite_differences():
 # ---------------------------------------------------------------- failures and projection
 def test_failure_is_reported_not_silent():
     pr, fixed, values = punch()
-    res = pr.solve(None, fixed, values, load_factors=[1.0, 2.0], max_iter=1)
+    res = pr.solve(None, fixed, values, load_factors=[1.0, 2.0], settings=ContactSettings(max_iter=1))
     assert not res.converged and "max_iter" in res.reason
     assert not res.steps[-1].converged
     # a floating slave that does not touch the master: singular Newton matrix
@@ -304,7 +306,9 @@ def test_bad_input_elsewhere():
         TwoBodyContact(upper, lower, "bottm", "top", eps_n=EPS)
     pr = TwoBodyContact(upper, lower, "bottom", "top", eps_n=EPS)
     with pytest.raises(ValueError, match="max_iter"):
-        pr.solve(max_iter=0)
+        pr.solve(settings=ContactSettings(max_iter=0))
+    with pytest.raises(ValueError, match="settings"):
+        pr.solve(settings={"max_iter": 5})
     with pytest.raises(ValueError, match="load_factors"):
         pr.solve(load_factors=[])
     with pytest.raises(ValueError, match="fixed_dofs"):
@@ -558,11 +562,11 @@ def test_line_search_breaks_the_two_state_newton_cycle():
     then 4, 2, 2, 2 iterations."""
     pr, fixed, vals = figure_4_13_coarse()
     lf = np.linspace(0.2, 1.0, 5)
-    plain = pr.solve(None, fixed, vals, load_factors=lf, max_iter=20)
+    plain = pr.solve(None, fixed, vals, load_factors=lf, settings=ContactSettings(max_iter=20))
     assert not plain.converged and "max_iter" in plain.reason
     r = np.asarray(plain.steps[0].residuals[-6:])
     assert np.allclose(r[:-2], r[2:], rtol=1e-6)            # period-2 cycle
-    res = pr.solve(None, fixed, vals, load_factors=lf, max_iter=20, line_search=True)
+    res = pr.solve(None, fixed, vals, load_factors=lf, settings=ContactSettings(max_iter=20, line_search=True))
     assert res.converged, res.reason
     assert max(res.iterations) <= 10
     first = res.steps[0]
@@ -584,12 +588,12 @@ def test_line_search_breaks_the_two_state_newton_cycle():
 def test_line_search_keeps_full_steps_when_they_decrease_the_residual():
     pr, fixed, values = punch()
     a = pr.solve(None, fixed, values, load_factors=np.linspace(0.25, 2.0, 8))
-    b = pr.solve(None, fixed, values, load_factors=np.linspace(0.25, 2.0, 8), line_search=True)
+    b = pr.solve(None, fixed, values, load_factors=np.linspace(0.25, 2.0, 8), settings=ContactSettings(line_search=True))
     assert b.converged and b.iterations == a.iterations
     assert all(l == 1.0 for st in b.steps for l in st.step_lengths)
     assert np.allclose(a.U, b.U, rtol=0, atol=1e-12 * np.abs(a.U).max())
     with pytest.raises(ValueError, match="min_step"):
-        pr.solve(None, fixed, values, min_step=0.0)
+        pr.solve(None, fixed, values, settings=ContactSettings(min_step=0.0))
 
 
 def test_fixed_values_named_when_wrong():
@@ -628,7 +632,7 @@ def test_figure_4_13_coarse_with_boundary_elements(combo):
     lf = np.linspace(0.2, 1.0, 5)
     # whether plain Newton cycles on this scene depends on round-off (it converged with
     # numpy 2.4 / OpenBLAS here, on the old and the new code alike): not asserted
-    res = pr.solve(None, fixed, vals, load_factors=lf, max_iter=30, line_search=True)
+    res = pr.solve(None, fixed, vals, load_factors=lf, settings=ContactSettings(max_iter=30, line_search=True))
     assert res.converged, res.reason
     assert max(res.iterations) <= 6
     assert all(np.all(np.diff(st.residuals) < 0) for st in res.steps)
@@ -665,11 +669,10 @@ def test_plastic_tangent_is_lazy_and_lu_orderings_reuse():
     pr, fixed, vals = problem()
     _, cs = pr.internal_force(np.zeros(pr.ndofs), np.zeros(len(pr.points)))
     assert "K_body" not in cs and cs["K_body"].shape == (pr.ndofs, pr.ndofs)
-    res = pr.solve(None, fixed, vals, load_factors=[0.5, 1.0], rtol=1e-10, max_iter=40,
-                   line_search=True)
+    res = pr.solve(None, fixed, vals, load_factors=[0.5, 1.0], settings=ContactSettings(rtol=1e-10, max_iter=40, line_search=True))
     assert res.converged, res.reason
     assert loading._ORDERS                              # orderings of the patterns seen
-    steps = loading.LoadSteps(pr, None, fixed, vals, "residual", None)
+    steps = loading.LoadSteps(pr, None, fixed, vals, ContactSettings())
     A = pr.tangent(pr.internal_force(res.U, res.slip)[1])[steps.free][:, steps.free].tocsc()
     A.sort_indices()
     b = np.random.default_rng(0).standard_normal(A.shape[0])
@@ -678,9 +681,8 @@ def test_plastic_tangent_is_lazy_and_lu_orderings_reuse():
     assert isinstance(lu, loading._PermutedLU)
     np.testing.assert_array_equal(lu.solve(b), spla.splu(A).solve(b))
     pr2, fixed, vals = problem()
-    res2 = pr2.solve(None, fixed, vals, load_factors=[0.5, 1.0], rtol=1e-10, max_iter=40,
-                     line_search=True, lu_ordering="MMD_AT_PLUS_A")
+    res2 = pr2.solve(None, fixed, vals, load_factors=[0.5, 1.0], settings=ContactSettings(rtol=1e-10, max_iter=40, line_search=True, lu_ordering="MMD_AT_PLUS_A"))
     assert res2.converged, res2.reason
     np.testing.assert_allclose(res2.U, res.U, atol=1e-8 * np.abs(res.U).max())
     with pytest.raises(ValueError, match="lu_ordering"):
-        pr2.solve(None, fixed, vals, lu_ordering="AMD")
+        pr2.solve(None, fixed, vals, settings=ContactSettings(lu_ordering="AMD"))

@@ -1,6 +1,6 @@
 """The two-pass (symmetric master-slave) penalty contact of
 hpfebe.contact.two_body.TwoBodyContact (``two_pass=True``) and its pass-through in
-hpfebe.scenes.stamping.ContactSettings.
+hpfebe.scenes.stamping.StampContact.
 
 Scene: slave block [0, 1] x [0, 1] (4 Q1 cells across) on the master block
 [0, 1] x [-1, 0] (5 cells across; non-matching interface y = 0), E = 266926, nu = 0.29,
@@ -25,8 +25,9 @@ import numpy as np
 import pytest
 
 from hpfebe.bodies import RigidObstacle
-from hpfebe.scenes import ContactSettings, stamp_body, touch
-from hpfebe.contact.two_body import OPEN, SLIP, TwoBodyContact
+from hpfebe.scenes import StampContact, stamp_body, touch
+from hpfebe.constitutive import OPEN, SLIP
+from hpfebe.contact import TwoBodyContact
 from hpfebe.fem.elasticity import ElasticBody, rectangle_mesh
 from hpfebe.fem.plastic_body import ElastoPlasticFE
 from hpfebe.constitutive.j2 import J2Material
@@ -162,7 +163,7 @@ def test_two_pass_must_be_bool(kw):
     with pytest.raises(ValueError, match="two_pass"):
         TwoBodyContact(up, lo, "bottom", "top", eps_n=1e-6, **kw)
     with pytest.raises(ValueError, match="two_pass"):
-        ContactSettings(**kw)
+        StampContact(**kw)
 
 
 def test_two_pass_needs_a_deformable_master():
@@ -177,7 +178,7 @@ def test_two_pass_needs_a_deformable_master():
 
 def test_be_stamp_on_fe_work_piece_two_pass():
     """A BE stamp (slave) lifted against by an elastoplastic FE work piece (master),
-    Coulomb friction, through stamping.touch with ContactSettings(two_pass=True): it
+    Coulomb friction, through stamping.touch with StampContact(two_pass=True): it
     converges and the stamp's side (pass 0) penetrates about half as deep as the
     single pass's (a stiff penalty against the bodies)."""
     mat = J2Material(E, NU, 4.0, 450.0, 1.0)
@@ -186,7 +187,7 @@ def test_be_stamp_on_fe_work_piece_two_pass():
         fe = ElastoPlasticFE(rectangle_mesh(-1, 1, -1, 0, 8, 3), mat, "full")
         stamp = stamp_body("BE", (-0.5, 0.5, 0.0, 1.0), 0.25, E, NU)
         tr = touch(stamp, fe, 1e-4, 2, 0, (0.0, -0.25),
-                   ContactSettings(10.0, 5.0, 0.2, two_pass=two))
+                   StampContact(10.0, 5.0, 0.2, two_pass=two))
         assert tr.converged, tr.reason
         res = tr.peak.result
         assert np.all(res.passes == 0) != two

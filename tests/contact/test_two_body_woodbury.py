@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 from hpfebe.contact.loading import WoodburySolver
-from hpfebe.contact.two_body import TwoBodyContact
+from hpfebe.contact import ContactSettings, TwoBodyContact
 from hpfebe.fem import refine_labelled
 from hpfebe.fem.elasticity import ElasticBody, rectangle_mesh
 
@@ -34,8 +34,7 @@ def _problem(refine=1):
 
 def _solve(linear_solver, predictor=False):
     pr, fixed, vals = _problem()
-    return pr.solve(None, fixed, vals, load_factors=np.arange(1, 6) / 5, rtol=1e-10,
-                    max_iter=30, linear_solver=linear_solver, predictor=predictor)
+    return pr.solve(None, fixed, vals, load_factors=np.arange(1, 6) / 5, settings=ContactSettings(rtol=1e-10, max_iter=30, linear_solver=linear_solver, predictor=predictor))
 
 
 @pytest.mark.parametrize("predictor", [False, True])
@@ -76,7 +75,7 @@ def test_schur_complement_inverse_and_solve_match_dense_algebra():
 def test_bad_linear_solver_is_rejected():
     pr, fixed, vals = _problem(refine=0)
     with pytest.raises(ValueError, match="linear_solver"):
-        pr.solve(None, fixed, vals, linear_solver="cholesky")
+        pr.solve(None, fixed, vals, settings=ContactSettings(linear_solver="cholesky"))
 
 
 def test_floating_body_is_reported_as_singular():
@@ -85,7 +84,7 @@ def test_floating_body_is_reported_as_singular():
     pr, fixed, vals = _problem(refine=0)
     keep = fixed < pr.offset           # only the slave's top fixed: the master floats
     f = pr.traction_load("master", "bottom", (0.0, 100.0))
-    res = pr.solve(f, fixed[keep], vals[keep], linear_solver="woodbury")
+    res = pr.solve(f, fixed[keep], vals[keep], settings=ContactSettings(linear_solver="woodbury"))
     assert not res.converged
     assert "singular" in res.reason
 
@@ -121,8 +120,7 @@ def test_fe_body_against_a_rigid_obstacle():
         pr = TwoBodyContact(FEBody(body), RigidObstacle(-1e-4, 1e-5), "bottom",
                             eps_n=1.0 / (10 * E), eps_t=1.0 / (5 * E), mu_f=0.3)
         fixed = pr.dofs_on("slave", "top")
-        res = pr.solve(None, fixed, np.zeros(fixed.size), load_factors=np.arange(1, 5) / 4,
-                       linear_solver=solver, line_search=True)
+        res = pr.solve(None, fixed, np.zeros(fixed.size), load_factors=np.arange(1, 5) / 4, settings=ContactSettings(linear_solver=solver, line_search=True))
         assert res.converged, res.reason
         out.append(res)
     a, b = out

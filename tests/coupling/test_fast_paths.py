@@ -13,7 +13,8 @@ from skfem import Basis
 from hpfebe.adaptivity.bem_estimator import lame_bem_indicators, lame_boundary_residuals
 from hpfebe.bem import LaplaceBEM, potentials, threads
 from hpfebe.bem.lame import LameBEM
-from hpfebe.coupling import NitscheFEBE, problem
+from hpfebe.coupling import NitscheFEBE
+from hpfebe.scenes.interface import problem
 from hpfebe.coupling.errors import (be_domain_errors, be_domain_errors_both,
                                     boundary_values)
 from hpfebe.fem.poisson import PoissonFE

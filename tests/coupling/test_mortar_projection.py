@@ -5,7 +5,7 @@ import pytest
 import scipy.linalg as sla
 from scipy.optimize import lsq_linear
 
-from hpfebe.contact.mortar import projected_cg
+from hpfebe.solvers import projected_cg
 from hpfebe.coupling.mortar import MortarProjection
 from hpfebe.geometry import BoundaryMesh
 from hpfebe.spaces import ContinuousSpace

@@ -10,13 +10,13 @@ import pandas as pd
 import pytest
 
 from hpfebe.analysis.rates import observed_rates
-from hpfebe.coupling import SINGULAR, SMOOTH, NitscheFEBE, problem
+from hpfebe.coupling import NitscheFEBE
 from hpfebe.coupling.coercivity import (coercivity_threshold, inverse_constant,
                                         lemma_2_2_3_bound)
 from hpfebe.coupling.errors import (_graded_corner_rule, be_domain_errors, be_solution_at,
-                                    be_trace_energy_error, boundary_values, fe_errors,
-                                    lambda_sweep)
+                                    be_trace_energy_error, boundary_values, fe_errors)
 from hpfebe.coupling.interface import common_refinement, interface_rule
+from hpfebe.scenes.interface import SINGULAR, SMOOTH, lambda_sweep, problem
 from hpfebe.fem import PoissonFE, block_grid
 
 PUBLISHED = "report/published/"
@@ -270,10 +270,10 @@ def test_solver_reports_residual():
 
 
 def test_solve_returns_solver_info():
-    """The Nitsche solve reports through the one SolverInfo of hpfebe.solvers.nonlinear."""
-    from hpfebe.coupling.examples import problem
+    """The Nitsche solve reports through the one SolverInfo of hpfebe.solvers."""
+    from hpfebe.scenes.interface import problem
     from hpfebe.coupling.nitsche import NitscheFEBE
-    from hpfebe.solvers.nonlinear import SolverInfo
+    from hpfebe.solvers import SolverInfo
 
     sol = NitscheFEBE(problem("smooth"), 2, 3, 1).solve()
     assert isinstance(sol.solver, SolverInfo) and sol.solver.converged

@@ -1,4 +1,4 @@
-"""Figures 3.2-3.9 (adaptive h-BEM with Coulomb friction, experiments/ch3_adaptive_bem.py)
+"""Figures 3.2-3.9 (adaptive h-BEM with Coulomb friction, experiments/ch3_adaptive_bem/)
 through the command line, quick configuration: every artefact written, its claims
 decided, the published numbers met.  The numerics are tested in the core
 (tests/adaptivity/test_bem_adaptive_core.py, tests/spaces/test_prolongation.py)."""

@@ -15,7 +15,7 @@ import pytest
 
 from hpfebe.adaptivity import (adapt, contact_traction_datum, fe_indicators, lame_stress,
                                mark_max, two_body_indicators)
-from hpfebe.contact.two_body import TwoBodyContact
+from hpfebe.contact import ContactSettings, TwoBodyContact
 from hpfebe.fem import is_conforming
 from hpfebe.fem.elasticity import ElasticBody, rectangle_mesh
 
@@ -35,8 +35,7 @@ def _solve(meshes):
     pr = TwoBodyContact(S, M, ["bottom", "left", "right"], ["top", "left", "right"],
                         eps_n=1.0 / (10 * E), eps_t=1.0 / (5 * E), mu_f=0.1)
     fixed, is_y = pr.stamp_dofs()
-    res = pr.solve(None, fixed, 5e-4 * is_y,
-                   load_factors=np.arange(1, 6) / 5, rtol=1e-10, max_iter=30)
+    res = pr.solve(None, fixed, 5e-4 * is_y, load_factors=np.arange(1, 6) / 5, settings=ContactSettings(rtol=1e-10, max_iter=30))
     assert res.converged, res.reason
     return pr, res
 

@@ -155,7 +155,7 @@ def test_local_mesh_size():
 
 # ----------------------------------------------------------------------------- one world
 def test_fe_domain_labels_are_the_mesh_boundaries():
-    from hpfebe.coupling.examples import SMOOTH
+    from hpfebe.scenes.interface import SMOOTH
 
     d = SMOOTH.fe_domain(2)
     assert d.facets is d.mesh.boundaries and set(d.facets) == {"D", "I", "N"}

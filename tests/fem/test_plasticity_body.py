@@ -11,7 +11,7 @@ from hpfebe.fem.elasticity import rectangle_mesh
 from hpfebe.bodies import PlasticFEBody
 from hpfebe.fem.plastic_body import DisplacementSteps, ElastoPlasticFE
 from hpfebe.constitutive.j2 import J2Material, J2State, return_map
-from hpfebe.solvers.nonlinear import load_path
+from hpfebe.solvers import load_path
 
 MAT = J2Material(266926.0, 0.29, 4.0, 450.0, 1.0)
 

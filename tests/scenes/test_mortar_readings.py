@@ -5,7 +5,8 @@ as initial gap), Coulomb friction inside DtN and the literal function transfer."
 import numpy as np
 import pytest
 
-from hpfebe.contact.mortar import model_gap, model_meshes, model_problem
+from hpfebe.scenes import model_gap, model_meshes, model_problem
+from hpfebe.solvers import DtNSettings, UzawaSettings
 from hpfebe.coupling.mortar import MortarProjection
 from hpfebe.geometry import BoundaryMesh
 
@@ -65,9 +66,10 @@ def test_flat_scene_and_bad_input():
     for kw, name in ((dict(geometry="curved"), "geometry"), (dict(side_depth=0.0), "side_depth")):
         with pytest.raises(ValueError, match=name):
             model_meshes(4, 3, 1, 1, **kw)
-    for kw, name in ((dict(friction="stick"), "friction"), (dict(transfer="dual"), "transfer")):
-        with pytest.raises(ValueError, match=name):
-            pr.dtn(0.5, 0.5, **kw)
+    with pytest.raises(ValueError, match="friction"):
+        pr.dtn(DtNSettings(0.5, 0.5), friction="stick")
+    with pytest.raises(ValueError, match="transfer"):
+        DtNSettings(0.5, 0.5, transfer="dual")
 
 
 def test_function_transfer_equals_functional_on_matching_meshes():
@@ -78,8 +80,8 @@ def test_function_transfer_equals_functional_on_matching_meshes():
     B, D = m.B.toarray(), m.D.toarray()
     # B = D Pi with Pi a permutation (dofs1 vs dofs2 order), M2 = Pi^T D Pi = B^T D^-1 B
     assert np.allclose(B.T @ np.linalg.solve(D, B), m.M2.toarray(), atol=1e-13)
-    a = pr.dtn(0.5, 0.5)
-    b = pr.dtn(0.5, 0.5, transfer="function")
+    a = pr.dtn(DtNSettings(0.5, 0.5))
+    b = pr.dtn(DtNSettings(0.5, 0.5, transfer="function"))
     assert a.info.converged and b.info.converged
     assert a.info.iterations == b.info.iterations
     assert np.allclose(a.U2, b.U2, atol=1e-9 * np.abs(a.U2).max())
@@ -87,7 +89,8 @@ def test_function_transfer_equals_functional_on_matching_meshes():
 
 def test_coulomb_dtn_respects_the_friction_cone():
     pr = model_problem(8, 6, 2, 1)
-    sol = pr.dtn(0.5, 0.5, friction="coulomb", tol=1e-8, max_uzawa=20000)
+    sol = pr.dtn(DtNSettings(0.5, 0.5, tol=1e-8, uzawa=UzawaSettings(max_iter=20000)),
+                 friction="coulomb")
     assert sol.info.converged, sol.info.reason
     rn, rt = pr.frame(pr.body1.reaction(pr.R.T @ sol.x))
     pn = np.maximum(0.0, -rn)

@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 from hpfebe.constitutive.j2 import J2Material
-from hpfebe.scenes import (ContactSettings, curve_difference, lift_schedule,
+from hpfebe.scenes import (StampContact, curve_difference, lift_schedule,
                            stamp_body, touch, work_piece)
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -22,7 +22,7 @@ WORK = (-2.0, 2.0, -3.0, -1.0)
 
 def _touch(kind, fe, box=(-1.0, 1.0, -1.0, 0.0), offset=None, tid=1):
     return touch(stamp_body(kind, box, 0.4, E, NU), fe, 4.2e-3, 4, 1, (1.0, -1.1),
-                 ContactSettings(), offset=offset, touch_id=tid)
+                 StampContact(), offset=offset, touch_id=tid)
 
 
 def test_fe_and_be_stamps_agree_and_leave_a_dent():
@@ -92,7 +92,7 @@ def test_bad_input():
     with pytest.raises(ValueError, match="n_load"):
         lift_schedule(1e-3, 0, 1)
     with pytest.raises(ValueError, match="mu_f"):
-        ContactSettings(mu_f=-0.1)
+        StampContact(mu_f=-0.1)
     with pytest.raises(ValueError, match="curves"):
         curve_difference([1.0], [1.0, 2.0])
 

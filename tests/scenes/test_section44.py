@@ -1,6 +1,7 @@
-"""Section 4.4 (experiments/ch4_section44.py): the quick run of every scene through the
-CLI, the penalty solution's penetration decreasing linearly in eps_n, the claims' kinds
-and links, the scenes computing only their artefacts."""
+"""Section 4.4 (the experiment package experiments/ch4_section44/ on the scene
+hpfebe.scenes.section44): the quick run of every scene through the CLI, the penalty
+solution's penetration decreasing linearly in eps_n, the claims' kinds and links, the
+scenes computing only their artefacts, the scene's field comparison."""
 
 import json
 import subprocess
@@ -186,20 +187,21 @@ def test_scenes_compute_their_artefacts_only(monkeypatch):
 # --------------------------------------------------------------------------- Tresca penalty
 def _quick_touch(**friction):
     """The quick-size penalty scene (BE stamp h = 0.5, 16 x 8 Q1 work piece, 2 load
-    increments) at 1/eps_n = 10 E with the given friction keywords of ContactSettings."""
-    from hpfebe.scenes import ContactSettings, stamp_body, touch, work_piece
-    from hpfebe.constitutive.j2 import J2Material
+    increments) at 1/eps_n = 10 E with the given friction keywords of StampContact."""
+    from hpfebe import J2Material
+    from hpfebe.scenes import stamp_body, touch, work_piece
+    from hpfebe.scenes.stamping import StampContact
 
     E, nu = 266926.0, 0.29
     stamp = stamp_body("BE", (-0.5, 0.5, 0.0, 2.0), 0.5, E, nu)
     fe = work_piece((-2.0, 2.0, -2.0, 0.0), 0.25, J2Material(E, nu, 4.0, 450.0, 1.0), "full")
-    tr = touch(stamp, fe, 1e-4, 2, 0, (0.0, -0.1), ContactSettings(10.0, 5.0, **friction))
+    tr = touch(stamp, fe, 1e-4, 2, 0, (0.0, -0.1), StampContact(10.0, 5.0, **friction))
     assert tr.converged, tr.reason
     return tr
 
 
 def test_tresca_penalty_touch_limits():
-    """ContactSettings F (Tresca bound) in stamping.touch: F = 0 is frictionless (the
+    """StampContact F (Tresca bound) in stamping.touch: F = 0 is frictionless (the
     Coulomb mu_f = 0 solution), a huge F sticks everywhere (the Coulomb solution with a
     huge mu_f), F = 0.22 (the mortar's) slips at the bound and restrains the stamp's
     lateral expansion between the two."""
@@ -227,11 +229,37 @@ def test_tresca_penalty_touch_limits():
 
 
 def test_contact_settings_F():
-    from hpfebe.scenes import ContactSettings
+    from hpfebe.scenes.stamping import StampContact
 
-    s = ContactSettings()
+    s = StampContact()
     assert s.F is None and s.friction() == {"mu_f": 0.2}          # default: Coulomb
-    assert ContactSettings(F=0.22).friction() == {"mu_f": 0.0, "F": 0.22}
+    assert StampContact(F=0.22).friction() == {"mu_f": 0.0, "F": 0.22}
     for bad in (-0.1, float("nan"), float("inf"), True, "0.2", [0.2]):
         with pytest.raises(ValueError, match="F"):
-            ContactSettings(F=bad)
+            StampContact(F=bad)
+
+
+# --------------------------------------------------------------------------- the scene
+def test_scene_fields_and_share():
+    """hpfebe.scenes.section44 on a small mortar scene: the fields of a solution against
+    themselves differ by nothing, on every node and cell of both bodies; the tangential
+    share of P lies in (0, 1) (the stamp slides: F = 0.22 > 0); the penalty scene has
+    the mortar's work piece mesh and a BE stamp."""
+    from hpfebe import J2Material, LameBEM
+    from hpfebe.scenes import (E, NU, field_differences, mortar_bodies, penalty_scene,
+                               section44_scene, tangential_share)
+
+    sc = section44_scene((4, 8), (16, 8), formulation="full")
+    sol = sc.monolithic()
+    assert sol.info.converged, sol.info.reason
+    f = dict(mortar_bodies(sc, sol), dev=(sc.work.mesh,
+                                          sol.extra["fields"]["dev_sigma_norm_mean"]))
+    rows = field_differences(f, f)
+    assert [(r["body"], r["field"]) for r in rows] == [
+        ("work", "u_x"), ("work", "u_y"), ("stamp", "u_x"), ("stamp", "u_y"),
+        ("work", "dev_sigma_norm")]
+    assert all(r["rel_l2"] == 0 and r["rel_max"] == 0 for r in rows)
+    assert rows[0]["n_points"] == 17 * 9 and rows[-1]["n_points"] == 16 * 8
+    assert 0 < tangential_share(sc, sol) < 1
+    stamp, fe = penalty_scene((16, 8), 0.5, J2Material(E, NU, 4.0, 450.0))
+    assert isinstance(stamp, LameBEM) and fe.mesh.t.shape[1] == 16 * 8

@@ -1,9 +1,9 @@
-"""Tests of the one iteration layer (hpfebe.solvers.nonlinear)."""
+"""Tests of the one iteration layer (hpfebe.solvers)."""
 
 import numpy as np
 import pytest
 
-from hpfebe.solvers.nonlinear import SolverInfo, fixed_point
+from hpfebe.solvers import SolverInfo, fixed_point
 
 
 def test_fixed_point_converges_on_a_contraction():

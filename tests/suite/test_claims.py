@@ -1,4 +1,4 @@
-"""Claim and rate helpers: hpfebe.suite.results.{rate,beats_uniform,range}_claim,
+"""Claim and rate helpers: hpfebe.suite.claims.{rate,beats_uniform,range}_claim,
 hpfebe.analysis.rates.{loglog_interpolate,fitted_rate,observed_rates},
 hpfebe.analysis.norms.energy_norm."""
 
@@ -10,8 +10,8 @@ import scipy.sparse as sp
 
 from hpfebe.analysis.norms import energy_norm
 from hpfebe.analysis.rates import fitted_rate, loglog_interpolate, observed_rates
-from hpfebe.suite.results import (Claim, beats_uniform_claim, joint_claim, range_claim,
-                            rate_claim)
+from hpfebe.suite.claims import (Claim, beats_uniform_claim, joint_claim, range_claim,
+                                 rate_claim)
 
 DOF = np.array([10.0, 40.0, 160.0, 640.0])
 ERR = 3.0 * DOF ** -0.5

@@ -135,7 +135,7 @@ def test_mesh_validation_is_near_linear():
     (dict(p_fe=2, be_h_inv=float("nan")), r"be_h_inv must be a positive number"),
 ])
 def test_nitsche_names_the_bad_argument(kw, match):
-    from hpfebe.coupling.examples import problem
+    from hpfebe.scenes.interface import problem
     from hpfebe.coupling.nitsche import NitscheFEBE
 
     args = dict(fe_h_inv=2, be_h_inv=3)
@@ -283,17 +283,17 @@ def test_csv_edited_to_other_numbers_is_damaged(quick_run, tmp_path):
 # --------------------------------------------------------------------------- interrupted runs
 SLOW_WRITER = r"""
 import os, sys, time
-from hpfebe import cli
+from hpfebe.suite import watch
 from hpfebe.suite.results import atomic_write
-cli.install_signal_handlers()
-cli._watch_parent_from_env()
+watch.install_signal_handlers()
+watch.watch_parent_from_env()
 def writer(f):
     f.write("x" * 10)
     print("writing", os.getpid(), flush=True)
     time.sleep(60)
 try:
     atomic_write(sys.argv[1], writer)
-except cli.Terminated as exc:
+except watch.Terminated as exc:
     sys.exit(128 + exc.signum)
 """
 
@@ -343,8 +343,8 @@ def test_job_stops_when_its_parent_is_killed(tmp_path):
 
 
 HEARTBEAT_WRITER = SLOW_WRITER.replace(
-    "cli._watch_parent_from_env()",
-    "cli.watch_heartbeat(sys.argv[2], timeout=1.5, interval=0.1)")
+    "watch.watch_parent_from_env()",
+    "watch.watch_heartbeat(sys.argv[2], timeout=1.5, interval=0.1)")
 
 
 def test_job_stops_when_the_heartbeat_stops(tmp_path):

@@ -12,9 +12,11 @@ import pandas as pd
 import pytest
 from matplotlib.figure import Figure
 
+from hpfebe.suite.claims import Claim
+from hpfebe.suite.published import compare
 from hpfebe.suite.report import (MAX_FIGURE_WIDTH, READING_KEY, build_report, chapter_of,
-                           claim_kind, collect, compare)
-from hpfebe.suite.results import ArtefactResult, Claim, write_result
+                                 claim_kind, collect)
+from hpfebe.suite.results import ArtefactResult, write_result
 
 ROOT = Path(__file__).resolve().parents[2]
 

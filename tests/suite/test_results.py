@@ -8,8 +8,10 @@ import pandas as pd
 import pytest
 from matplotlib.figure import Figure
 
-from hpfebe import results as res
-from hpfebe.suite.results import ArtefactResult, Claim, atomic_write, write_result
+from hpfebe.suite import results as res
+from hpfebe.suite.claims import Claim
+from hpfebe.suite.progressbar import progress
+from hpfebe.suite.results import ArtefactResult, atomic_write, write_result
 
 
 def _result(**kw):
@@ -176,6 +178,31 @@ def test_json_is_strict_with_non_finite_meta(tmp_path):
 
 
 def test_progress_is_quiet_without_tty():
-    bar = res.progress(range(3))
+    bar = progress(range(3))
     assert list(bar) == [0, 1, 2]
     assert bar.disable  # pytest captures stderr: not a TTY
+
+
+def test_suite_facade_is_light_and_complete():
+    """``hpfebe.suite`` exports the names the experiments use, each the object of the
+    module that defines it, and imports none of them (nor pandas) until asked."""
+    import subprocess
+    import sys
+
+    code = ("import sys, hpfebe.suite as s; "
+            "print(sorted(m for m in ('pandas', 'matplotlib', 'hpfebe.suite.results', "
+            "'hpfebe.suite.report') if m in sys.modules))")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         check=True).stdout.strip()
+    assert out == "[]"
+    import importlib
+
+    import hpfebe.suite as suite
+
+    for name in suite.__all__:
+        obj = getattr(suite, name)
+        home = importlib.import_module(f"hpfebe.suite.{suite._API[name]}")
+        assert obj is getattr(home, name), name
+    for name in ("Claim", "ArtefactResult", "progress", "rate_claim", "range_claim",
+                 "joint_claim", "beats_uniform_claim", "from_config", "CELLS_PREFIX"):
+        assert name in suite.__all__

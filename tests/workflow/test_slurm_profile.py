@@ -50,6 +50,17 @@ def test_named_rules_exist(profile, rules):
     assert named <= rules, f"no such rule: {sorted(named - rules)}"
 
 
+def test_status_checks_capped(profile):
+    """The plugin's back-off (10 s more after each check that saw no job end) is capped
+    by the Snakefile at `seconds-between-status-checks`, through the plugin's property
+    (skipped without the plugin; a plugin version without it fails here)."""
+    assert 1 <= profile["seconds-between-status-checks"] <= 30
+    assert "_SlurmExecutor.next_seconds_between_status_checks" in (ROOT / "Snakefile").read_text()
+    plugin = pytest.importorskip("snakemake_executor_plugin_slurm")
+    prop = getattr(plugin.Executor, "next_seconds_between_status_checks", None)
+    assert isinstance(prop, property) and prop.fset is not None
+
+
 def test_groups_run_their_jobs_one_after_another(profile):
     """Without a per-job slot of local scope, Snakemake sizes a group job to run all its
     jobs side by side (N CPUs, N x memory): larger than a node, it never starts."""

@@ -87,6 +87,21 @@ def test_job_commands_do_not_change_between_calls(tree):
     assert "HPFEBE_PARENT_PID" not in runs[0].stdout
 
 
+def test_registry_cache_written_by_the_main_snakemake(tree):
+    """The main Snakemake writes the registry it discovered to .snakemake/hpfebe/ (the
+    nested Snakemakes of cluster jobs read it instead of parsing every experiment file
+    again, while no file under experiments/ changed)."""
+    import pickle
+
+    r = snakemake("-n", cwd=tree)
+    assert r.returncode == 0, r.stdout + r.stderr
+    stamp, cached = pickle.loads((tree / ".snakemake" / "hpfebe" / "registry.pickle")
+                                 .read_bytes())
+    fresh = _registry_module().discover(tree / "experiments")
+    assert [j.rule for j in cached.jobs] == [j.rule for j in fresh.jobs]
+    assert str(tree / "experiments" / "registry.py") in stamp
+
+
 def test_one_rule_per_job(tree):
     reg = _registry_module().discover(ROOT / "experiments")
     r = snakemake("--list-rules", cwd=tree)
@@ -175,6 +190,75 @@ def test_slurm_profile_dry_run(tree):
                                "(pip install -e '.[cluster]')")
     r = snakemake("-n", "--profile", "profiles/slurm", cwd=tree)
     assert r.returncode == 0, r.stdout + r.stderr
+
+
+# --------------------------------------------------------------------------- orphans
+# A job whose parent Snakemake is killed outright: its watch thread polls only every
+# 60 s here, so only the hook that every rename calls (hpfebe.suite.watch.before_rename)
+# can keep its results out.  The job fills its temporary files while the parent lives
+# and renames them just after the parent is gone (what a job finishing 0.03 s after the
+# kill -9 did under the 1 s poll).
+ORPHAN_JOB = r"""
+import os, sys, time
+from pathlib import Path
+import meshio, numpy as np
+from hpfebe.suite import watch
+from hpfebe.suite.results import atomic_write
+from hpfebe.io.vtu import write_vtu
+watch.install_signal_handlers()
+parent, out = int(os.environ[watch.PARENT_PID_ENV]), Path(sys.argv[1])
+watch.watch_parent(parent, interval=60.0)
+def gone():
+    try:
+        with open(f"/proc/{parent}/stat") as f:
+            return f.read().rsplit(")", 1)[1].split()[0] in ("Z", "X")
+    except OSError:
+        return True
+def writer(f):
+    f.write("x\n")
+    print("writing", flush=True)
+    while not gone():
+        time.sleep(0.001)
+landed = []
+for what, write in (
+        ("csv", lambda: atomic_write(out / "table_9_9.csv", writer)),
+        ("vtu", lambda: write_vtu(out / "table_9_9_u.vtu",
+                                  meshio.Mesh(np.zeros((2, 3)), [("line", [[0, 1]])]),
+                                  before_rename=watch.before_rename))):
+    try:
+        write()
+        landed.append(what)
+    except watch.Terminated:
+        pass
+print("landed", *landed, flush=True)
+"""
+
+
+@pytest.mark.skipif(not Path("/proc").is_dir(), reason="Linux /proc")
+def test_no_result_lands_after_the_parent_is_gone(tmp_path):
+    """kill -9 of the parent while its job writes: the job's renames after the kill are
+    aborted (no result file, no temporary left), although its watch thread has not
+    polled yet."""
+    out = tmp_path / "results"
+    out.mkdir()
+    parent_code = ("import os, subprocess, sys, time\n"
+                   "from hpfebe.suite import watch\n"
+                   "env = dict(os.environ, **{watch.PARENT_PID_ENV: str(os.getpid())})\n"
+                   f"subprocess.Popen([sys.executable, '-c', {ORPHAN_JOB!r}, {str(out)!r}],"
+                   " env=env)\n"
+                   "time.sleep(120)\n")
+    parent = subprocess.Popen([sys.executable, "-c", parent_code], stdout=subprocess.PIPE,
+                              text=True)
+    try:
+        line = parent.stdout.readline()
+        assert line.startswith("writing"), line
+        parent.kill()
+        parent.wait(timeout=10)
+        rest = parent.stdout.read()        # the job's stdout: until it ends
+    finally:
+        parent.kill()
+    assert rest.split() == ["landed"], rest
+    assert sorted(p.name for p in out.iterdir()) == []
 
 
 # --------------------------------------------------------------------------- registry

@@ -14,9 +14,11 @@
 """
 
 from .adaptive import AdaptiveHistory, adapt, default_refine
-from .bem_estimator import (bem_indicators, boundary_residuals, error_measure_B,
+from .bem_estimator import (INDICATOR_VARIANTS, bem_indicators, boundary_residuals,
+                            consistency_weight, contact_traction, error_measure_B,
                             error_measure_B_lame, lame_bem_indicators,
-                            lame_boundary_residuals, solve_lame_mixed, solve_laplace_mixed)
+                            lame_boundary_residuals, lame_contact_indicators, norm_B,
+                            solve_lame_mixed, solve_laplace_mixed, true_error)
 from .fe_estimator import energy_error as fe_energy_error
 from .fe_estimator import energy_error_elasticity as fe_energy_error_elasticity
 from .fe_estimator import (contact_traction_datum, fe_indicators, hooke_stress, lame_stress,
@@ -30,4 +32,5 @@ __all__ = ["AdaptiveHistory", "adapt", "default_refine", "bem_indicators",
            "solve_lame_mixed", "fe_energy_error", "fe_energy_error_elasticity",
            "fe_indicators", "lame_stress", "hooke_stress", "contact_traction_datum",
            "two_body_indicators", "mark_bulk", "mark_doerfler", "mark_max", "mortar_indicators",
-           "hp_refine"]
+           "hp_refine", "INDICATOR_VARIANTS", "consistency_weight", "contact_traction",
+           "lame_contact_indicators", "norm_B", "true_error"]

@@ -1,6 +1,6 @@
 """The hp-adaptive mortar contact of Section 4.3.5: the residual indicator of the two BE
-bodies of a :class:`hpfebe.contact.mortar.MortarContact` solution and the h-or-p decision
-of Algorithm 4.6."""
+bodies of a :class:`hpfebe.contact.mortar.MortarContact` solution, the h-or-p decision
+of Algorithm 4.6 (:func:`hp_refine`) and the algorithm on both bodies (:func:`hp_adapt`)."""
 
 from __future__ import annotations
 
@@ -10,6 +10,7 @@ import numpy as np
 
 from ..geometry import BoundaryMesh
 from ..quadrature import gauss_legendre
+from .adaptive import adapt
 from .bem_estimator import lame_bem_indicators
 
 if TYPE_CHECKING:  # annotations only: adaptivity sits above contact, contact never imports it
@@ -99,3 +100,30 @@ def hp_refine(mesh: BoundaryMesh, marked, eta, h_fraction: float = 0.9) -> Bound
     p = marked & ~h
     out = mesh.raise_degree(p) if p.any() else mesh
     return out.refine(h) if h.any() else out
+
+
+def hp_adapt(meshes, solve, n_steps: int, q1: float = 0.85, q2: float = 0.9):
+    """Algorithm 4.6 on both bodies of a mortar contact problem through
+    :func:`hpfebe.adaptivity.adapt`: ``solve(meshes)`` returns ((problem, solution),
+    (ndof1, ndof2)) as ``adapt`` expects; the indicator :func:`mortar_indicators`;
+    marking eta_I >= q1 eta_max per body; h-refinement (bisection) where eta_I >= q2
+    eta_max, else p + 1 (:func:`hp_refine`); ``n_steps`` solves.  Returns (the
+    :class:`~hpfebe.adaptivity.AdaptiveHistory`, the number of bisections and degree
+    raises per refinement of each body: dicts body, n_h, n_p)."""
+    store, counts = {}, []
+
+    def estimate(meshes, state):
+        store["eta"] = mortar_indicators(*state)
+        return store["eta"]
+
+    def refiner(k):
+        def refine(mesh, marked):
+            eta = store["eta"][k]
+            nh = int(np.sum(marked & (eta >= q2 * eta.max())))
+            counts.append(dict(body=k + 1, n_h=nh, n_p=int(marked.sum()) - nh))
+            return hp_refine(mesh, marked, eta, q2)
+        return refine
+
+    hist = adapt(tuple(meshes), solve, estimate, n_steps=n_steps, theta=q1, marking="max",
+                 refine=[refiner(0), refiner(1)])
+    return hist, counts

@@ -134,7 +134,7 @@ def contract_block(Kq, Phi, Psi, nx, ny, mt, mr, d, tmp, out):
     the tensor quadrature sum of a local block, in two stages (inner sum over the trial
     points into ``tmp`` (nx, mr, d*d), then the test points); O(nx ny + nx mt mr) per
     kernel component instead of O(nx ny mt mr).  (The far-field fast path of
-    :func:`hpfebe.bem.assembly._assemble_chunk` writes the same sum out over its
+    :func:`hpfebe.bem.assembly_kernels._assemble_rows_serial` writes the same sum out over its
     tabulated bases: this helper there - called, inlined, on slices or on indexed 4D
     tables - made the assembly 1.3-1.9x slower at N = 4096, measured.)"""
     dd = d * d

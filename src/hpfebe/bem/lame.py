@@ -43,7 +43,7 @@ Galerkin: W = T^T Vt T with T the exact derivative matrix of :mod:`hpfebe.spaces
 component) and Vt assembled on W_hp by the same :func:`assemble` as V.  The constant R is
 irrelevant here (tangential derivatives have zero mean on closed curves).
 
-On meshes with all degrees 1, V, Vt and K have closed forms (:mod:`hpfebe.bem.lowest_order`,
+On meshes with all degrees 1, V, Vt and K have closed forms (:mod:`hpfebe.bem.lowest_order_lame`,
 formulas (Q1), (Q2), (L1), (L2): K by the Guenter-derivative representation
 K = K_Laplace I + (V_Laplace I - 2 mu V)(I J) T, J = [[0, 1], [-1, 0]]), used unless
 ``closed_form=False``; the general quadrature path of :func:`assemble` is the reference
@@ -70,15 +70,15 @@ import math
 import numpy as np
 import scipy.sparse as sp
 
+from ..constitutive.materials import lame_constants, linear_stress
 from ..geometry import BoundaryMesh
-from ..constitutive.materials import PLANES, lame_constants, linear_stress  # noqa: F401  (re-exported)
 from ..spaces import ContinuousSpace, DiscontinuousSpace
 from .assembly import assemble, local_block, sandwich
 from .kernels import (KP_C1, KP_C1_C2, KP_C1_LOG_R, KP_C2, KP_ET, KP_ET_LOG_R, KP_LAMBDA,
                       KP_LAME_SIZE, KP_MU, LAME_DL, LAME_HS, LAME_SL)
 from .laplace import P1_W_DIRECT_MAX
 from .lowest_order import applies as _closed_form_applies
-from .lowest_order import lame_p1, lame_p1_w
+from .lowest_order_lame import lame_p1, lame_p1_w
 from .operators import BoundaryOperators, mesh_diameter
 from .potentials import (POT_LAME_DL, POT_LAME_DL_GRAD, POT_LAME_SL, POT_LAME_SL_GRAD,
                          evaluate_potential)
@@ -147,7 +147,7 @@ class LameBEM(BoundaryOperators):
     scale : length scale R of the fundamental solution (default: 2 x diameter)
     zero_force : constrain Psi to zero total force (scale-invariant S_hat, module doc)
     closed_form : on a mesh with all degrees 1, V, K and Vt by the closed forms of
-        :mod:`hpfebe.bem.lowest_order` (one pass; W = T^T Vt T without forming T up to
+        :mod:`hpfebe.bem.lowest_order_lame` (one pass; W = T^T Vt T without forming T up to
         P1_W_DIRECT_MAX elements): equal to the quadrature path to round-off; ``False``
         forces the general quadrature path
 

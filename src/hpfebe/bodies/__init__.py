@@ -7,7 +7,11 @@ its contact wrapper :class:`PlasticBEBody`, :mod:`.plastic_be`) and a rigid obst
 """
 
 from .body import BEBody, FEBody, PlasticFEBody, RigidObstacle, as_body
+from .condensed import CondensedBody
+from .cell_operators import CellStrainOperators
 from .plastic_be import DirichletSolver, ElastoPlasticBE, PlasticBEBody, staggered_path
 
 __all__ = ["BEBody", "FEBody", "PlasticFEBody", "RigidObstacle", "as_body",
            "ElastoPlasticBE", "PlasticBEBody", "DirichletSolver", "staggered_path"]
+__all__ += ["CondensedBody"]
+__all__ += ["CellStrainOperators"]

@@ -9,37 +9,9 @@ operators, the Newton potential of :mod:`hpfebe.fem.newton_potential` and the J2
 map; :class:`PlasticBEBody` is its contact-body wrapper (like
 :class:`hpfebe.bodies.body.PlasticFEBody`).
 
-**The boundary equation (4.29).**  With tau = C : eps_p (in-plane), the weak form of
-div sigma = 0, sigma = C : (eps(u) - eps_p), tested with the elastic extension Phi~ of a
-boundary function Phi (div C eps(Phi~) = 0), is
-
-    <S u, Phi> - G(eps_p, Phi) = <t, Phi>,
-    G(eps_p, Phi) = (C : eps_p, eps(Phi~))_Omega = sum_cells int_{d c} (tau_c n_c) . Phi~ ds,
-
-(divergence theorem cell by cell, tau constant per cell) - the thesis's
-G = -<N(div(C : eps_p)), Phi> + <(C : eps_p) n, Phi>: the cell edges on Gamma give
-<tau n, Phi> (Phi~ = Phi there), the interior edges the Newton-potential part through
-Phi~(y) = (V~ Psi(Phi) - K~ Phi)(y) (Somigliana with the discrete Dirichlet-to-Neumann
-traction Psi, :meth:`LameBEM.representation`).  A uniform eps_p gives exactly
-G = <tau n, Phi>, and u = eps_p x solves S_hat u = G (S_hat reproduces linear fields on
-a polygon), so the uniform initial-strain problem is solved exactly (tested).
-
-**The strain in the cells.**  The return map works with the cell average
-eps_c = |c|^-1 int_{d c} sym(u x n) ds of the strain (one state per cell), u on the cell
-edges from the initial-strain Somigliana identity u = V~ t - K~ u + w (w the Newton
-potential, :func:`newton_operators`; the true traction from the first-kind equation
-<V t, psi> = <(K + M/2) u, psi> - <w, psi>, with the zero-total-force projection of
-LameBEM since t is in equilibrium), i.e. u = Phi~[u] - V~ P <w, .> + w on interior edges
-and the P1 trace on Gamma:
-
-    g_c = A_u u + A_tau tau  (rows 4 c + 2 i + m, g = cell-average grad u),
-    G   = (area-weighted A_u)^T,
-
-so G and the strain map are adjoint by construction.  This matters: with the strain
-evaluated at the centroids instead (a first version), the map eps_p -> -dev sigma / 2 mu
-had eigenvalues down to -0.19 (spurious modes; the explicit update blew up for small
-hardening); with the cell averages its spectrum lies in [0, 1] as for the continuous
-operator (measured, N = 4 punch).
+The boundary equation (4.29) and the strain in the cells: the operators of
+:mod:`hpfebe.bodies.cell_operators` (:class:`CellStrainOperators`, the base of
+:class:`ElastoPlasticBE`).
 
 **Algorithm 4.2** (forward Euler in eps_p, backward Euler for contact): the matrix is
 S_hat alone; the plastic strain enters the right-hand side.  ``internal_force(u)``
@@ -49,7 +21,7 @@ the return map per cell (cell-average strain) from the committed state with the 
 the plastic strain is one load step behind (explicit), so the result depends on the step
 size (tests/bodies/test_plastic_be.py measures it).  ``staggered_step`` iterates the update
 within one load step (Algorithm 4.2 step v with eps_p^(k) in b, the fixed point of
-:func:`hpfebe.solvers.nonlinear.fixed_point`) - it converges to the implicit solution, linearly
+:func:`hpfebe.solvers.fixed_point`) - it converges to the implicit solution, linearly
 with a rate near 1 - 2 mu / (2 mu + 2/3 H) ... (slow for small hardening).
 
 **Near-perfect plasticity (the thesis material of Section 4.4: E / sigma_Y = 66700,
@@ -59,7 +31,7 @@ H = 450).**  Two things matter, both measured (notes in tests/bodies/test_plasti
   a lift increment of 4.2e-4 is ~30 yield strains; the Example 2 stamp reaction is 352
   with 10 increments, 125 with 40, against 24.8 with backward Euler (h = 0.4).  The
   figures therefore use ``scheme="implicit"``: the backward Euler cell strains at u,
-  F(e) = e - B u - M tau(RM(e)) = 0, solved by :func:`hpfebe.solvers.nonlinear.newton` with
+  F(e) = e - B u - M tau(RM(e)) = 0, solved by :func:`hpfebe.solvers.newton` with
   Armijo line search and the Jacobian reduced to the plastic cells
   (:class:`_CellStrainProblem`), and the consistent tangent for the contact Newton;
 * constant plastic strain on axis-parallel squares locks under isochoric flow (its
@@ -77,15 +49,14 @@ import scipy.linalg as sla
 import scipy.sparse as sp
 
 from ..bem.lame import LameBEM
-from ..bem.potentials import POT_LAME_DL, evaluate_potential
 from ..geometry import BoundaryMesh
-from ..fem.newton_potential import (CellComplex, edge_integrals, initial_stress,
-                                   kelvin_constants, newton_operators)
+from ..fem.elasticity import rectangle_mesh
+from ..fem.newton_potential import CellComplex, initial_stress
 from .body import BEBody
+from .cell_operators import CellStrainOperators, match_nodes
 from ..constitutive.j2 import J2Material, J2State, embed_plane, return_map, tensor_norm, dev
 from ..solvers import Iterate, LineSearch, SingularStep, fixed_point, newton
 
-GAUSS_EDGE = 4
 SCHEMES = ("explicit", "implicit")
 
 
@@ -122,25 +93,7 @@ def _times_blocks_kernel(A, D):
     return out
 
 
-def _graded_rule(levels: int = 4, order: int = 8):
-    """Composite Gauss rule on [0, 1] graded geometrically (ratio 1/4) towards both
-    ends: w on Gamma behaves like r log r at the nodes where interior cell edges meet
-    Gamma, which plain Gauss integrates only to ~1e-5."""
-    left = 0.25 ** np.arange(levels, 0, -1) * 0.5                # 1/2 4^-k
-    br = np.concatenate([[0.0], left, [0.5], 1.0 - left[::-1], [1.0]])
-    gx, gw = np.polynomial.legendre.leggauss(order)
-    a, b = br[:-1, None], br[1:, None]
-    return (a + 0.5 * (gx + 1) * (b - a)).ravel(), (0.5 * gw * (b - a)).ravel()
-
-
-def _match_nodes(points: np.ndarray, nodes: np.ndarray, tol: float) -> np.ndarray:
-    """Index of the BEM node equal to each point (within tol), -1 if none."""
-    d = np.linalg.norm(points[:, None, :] - nodes[None, :, :], axis=-1)
-    j = np.argmin(d, axis=1)
-    return np.where(d[np.arange(len(points)), j] <= tol, j, -1)
-
-
-class ElastoPlasticBE:
+class ElastoPlasticBE(CellStrainOperators):
     """J2 elastoplastic BE body.  ``bem``: :class:`LameBEM` of degree 1 (plane strain),
     ``cells``: :class:`CellComplex` covering the region where plastic strain may appear
     (the whole work piece or a part of it, its nodes on Gamma coinciding with BEM nodes),
@@ -153,122 +106,17 @@ class ElastoPlasticBE:
         if scheme not in SCHEMES:
             raise ValueError(f"scheme must be one of {SCHEMES}, got {scheme!r}")
         self.scheme = scheme
-        if not isinstance(bem, LameBEM):
-            raise ValueError(f"bem must be a LameBEM (2D elasticity), got {type(bem).__name__}")
-        if not isinstance(cells, CellComplex):
-            raise ValueError(f"cells must be a CellComplex, got {type(cells).__name__}")
         if not isinstance(material, J2Material):
             raise ValueError(f"material must be a J2Material, got {type(material).__name__}")
-        if bem.plane != "strain":
-            raise ValueError(f"bem must be plane strain (J2 body), got plane={bem.plane!r}")
-        if not np.all(bem.mesh.degrees == 1):
-            raise ValueError("bem must have degree 1 on every element (P1 displacements)")
-        if not (np.isclose(bem.E, material.E) and np.isclose(bem.nu, material.nu)):
+        if isinstance(bem, LameBEM) and not (np.isclose(bem.E, material.E) and
+                                             np.isclose(bem.nu, material.nu)):
             raise ValueError(f"material (E={material.E}, nu={material.nu}) must have the "
                              f"bem's E={bem.E}, nu={bem.nu}")
-        self.bem, self.cells, self.material = bem, cells, material
-        self.E, self.nu = material.E, material.nu
-        self.ndofs = 2 * bem.V_space.ndof
-        self.S = bem.S_hat
-        self.K = sp.csr_matrix(self.S)
-        self.points = cells.centroids
-        self._build()
+        self.material = material
+        super().__init__(bem, cells, material.E, material.nu)
         self.committed = J2State.zeros(cells.ncells)
         self.sigma = np.zeros((cells.ncells, 3, 3))
         self.plastic = np.zeros(cells.ncells, dtype=bool)
-
-    # ------------------------------------------------------------------ operators
-    def _P(self, Y: np.ndarray) -> np.ndarray:
-        """Constrained V^{-1} (zero total force, as LameBEM.Psi) applied to columns Y."""
-        bem = self.bem
-        X = sla.cho_solve(bem.V_cho, Y)
-        if bem.constrained:
-            C = bem.constraints
-            VC = sla.cho_solve(bem.V_cho, C)
-            X = X - VC @ np.linalg.solve(C.T @ VC, C.T @ X)
-        return X
-
-    def _columns(self, fn, n: int, pts: np.ndarray, width: int) -> np.ndarray:
-        """Matrix whose column k is fn(pts, e_k) flattened (one vectorised potential
-        evaluation per basis function)."""
-        out = np.empty((len(pts) * width, n))
-        e = np.zeros(n)
-        for k in range(n):
-            e[k] = 1.0
-            out[:, k] = fn(pts, e).ravel()
-            e[k] = 0.0
-        return out
-
-    def _build(self):
-        """The cell-average displacement gradients g_c = |c|^-1 int_{d c} u (x) n ds
-        (rows 4 c + 2 i + m) as A_u u + A_tau tau, and G = (area-weighted A_u)^T."""
-        bem, cx = self.bem, self.cells
-        mesh = bem.mesh
-        nV = 2 * bem.V_space.ndof
-        nc, nc3 = cx.ncells, 3 * cx.ncells
-        tol = 1e-9 * mesh.diameter
-        # --- cell edges on Gamma (both end nodes BEM nodes joined by a BEM element)
-        ia = _match_nodes(cx.nodes[cx.edges[:, 0]], mesh.nodes, tol)
-        ib = _match_nodes(cx.nodes[cx.edges[:, 1]], mesh.nodes, tol)
-        el = {(int(a), int(b)) for a, b in mesh.elements}
-        on = np.array([(a, b) in el or (b, a) in el for a, b in zip(ia, ib)])
-        on &= (ia >= 0) & (ib >= 0) & cx.boundary_edge
-        if not np.any(on):
-            raise ValueError("cells must share edges with the BEM boundary (no cell edge "
-                             "lies on Gamma: node coordinates do not match)")
-        node_dof = np.full(len(mesh.nodes), -1)
-        node_dof[mesh.elements[:, 0]] = bem.V_space.elem_dofs[:, 0]
-        node_dof[mesh.elements[:, 1]] = bem.V_space.elem_dofs[:, 1]
-        # edge weights: |c|^-1 int_e (.) n_m ds  ->  row factor n_m L_e / |c|
-        fac = (cx.lengths / cx.areas[cx.edge_cell])[:, None] * cx.normals     # (S, 2)
-        A_u = np.zeros((nc, 2, 2, nV))
-        A_tau = np.zeros((nc, 2, 2, nc3))
-        # Gamma edges: the P1 trace, int_e u ds = L/2 (u_A + u_B)
-        e_on = np.flatnonzero(on)
-        for ends in (ia[on], ib[on]):
-            for i in range(2):
-                np.add.at(A_u, (cx.edge_cell[e_on], i, slice(None), 2 * node_dof[ends] + i),
-                          0.5 * fac[e_on])
-        # interior edges: u(y) = Phi~[u](y) - SL(P G_w tau)(y) + w(y), Gauss points on
-        # each geometric edge once (shared by two cells)
-        off = np.flatnonzero(~on)
-        if off.size:
-            key = np.sort(cx.edges[off], axis=1)
-            uniq, inv = np.unique(key, axis=0, return_inverse=True)
-            inv = inv.ravel()
-            gx, gw = np.polynomial.legendre.leggauss(GAUSS_EDGE)
-            s, w = 0.5 * (gx + 1), 0.5 * gw
-            a, b = cx.nodes[uniq[:, 0]], cx.nodes[uniq[:, 1]]
-            Y = (a[:, None] + s[None, :, None] * (b - a)[:, None]).reshape(-1, 2)
-            R, Ut = self.point_operators(Y)
-            Ut = Ut.reshape(len(uniq), len(s), 2, nc3)
-            Uu = R.reshape(len(uniq), len(s), 2, nV)
-            cells_off = cx.edge_cell[off]
-            np.add.at(A_u, cells_off, np.einsum("eqiv,q,em->eimv", Uu[inv], w, fac[off]))
-            np.add.at(A_tau, cells_off, np.einsum("eqit,q,em->eimt", Ut[inv], w, fac[off]))
-        self.A_u = A_u.reshape(4 * nc, nV)
-        self.A_tau = A_tau.reshape(4 * nc, nc3)
-        # G_v = sum_c |c| tau_c : g_c(phi_v)   (tau : g = t11 g11 + t22 g22 + t12 (g12 + g21))
-        T = np.zeros((nc, 2, 2, nc, 3))
-        c = np.arange(nc)
-        T[c, 0, 0, c, 0] = T[c, 1, 1, c, 1] = T[c, 0, 1, c, 2] = T[c, 1, 0, c, 2] = 1.0
-        T *= cx.areas[:, None, None, None, None]
-        self.G = self.A_u.T @ T.reshape(4 * nc, nc3)
-
-    def point_operators(self, Y: np.ndarray):
-        """(R, U_tau), each with rows 2 k + i: u(Y_k) = R u + U_tau tau at interior
-        points Y (the initial-strain Somigliana identity, module doc:
-        u = V~ Psi(u) - K~ u + w - V~ P <w, .>)."""
-        bem = self.bem
-        nV = 2 * bem.V_space.ndof
-        Y = np.atleast_2d(np.asarray(Y, dtype=float))
-        SL = self._single_layer(Y)                                       # (2Y, nW)
-        DL = -self._columns(lambda p, e: evaluate_potential(POT_LAME_DL, bem.kp, 2, p,
-                                                            bem.V_space, e), nV, Y, 2)
-        if getattr(self, "_PB", None) is None:
-            self._PB = (self._P(bem.B), self._P(self._boundary_w()))
-        Nw, _ = newton_operators(self.cells, Y, self.E, self.nu, gradient=False)
-        return DL + SL @ self._PB[0], Nw - SL @ self._PB[1]
 
     def node_displacements(self, u: np.ndarray) -> np.ndarray:
         """(n, 2) displacement at the cell nodes for the boundary displacement u and the
@@ -279,7 +127,7 @@ class ElastoPlasticBE:
         if u.shape != (self.ndofs,):
             raise ValueError(f"u must have shape ({self.ndofs},), got {u.shape}")
         mesh = self.bem.mesh
-        idx = _match_nodes(self.cells.nodes, mesh.nodes, 1e-9 * mesh.diameter)
+        idx = match_nodes(self.cells.nodes, mesh.nodes, 1e-9 * mesh.diameter)
         node_dof = np.full(len(mesh.nodes), -1)
         node_dof[mesh.elements[:, 0]] = self.bem.V_space.elem_dofs[:, 0]
         node_dof[mesh.elements[:, 1]] = self.bem.V_space.elem_dofs[:, 1]
@@ -315,35 +163,6 @@ class ElastoPlasticBE:
         if key not in f:
             raise ValueError(f"key must be one of {sorted(f)}, got {key!r}")
         return float(f[key][self.cells_at(point)].mean())
-
-    def _single_layer(self, Y: np.ndarray) -> np.ndarray:
-        """(2 len(Y), nW): the single-layer potential V~ psi at points Y of every P0
-        basis function, by the closed-form segment integrals (with the log R term of
-        :mod:`hpfebe.bem.lame`)."""
-        bem, mesh = self.bem, self.bem.mesh
-        c1, c2 = kelvin_constants(self.E, self.nu)
-        IG = edge_integrals(Y, mesh.a, mesh.b, c1, c2, gradient=False)      # (P, S, 2, 2)
-        IG = IG + c1 * np.log(bem.scale) * mesh.lengths[None, :, None, None] * np.eye(2)
-        out = np.zeros((len(Y), 2, 2 * bem.W_space.ndof))
-        d = bem.W_space.elem_dofs[:, 0]
-        for k in range(2):
-            out[:, :, 2 * d + k] = IG[:, :, :, k].transpose(0, 2, 1)
-        return out.reshape(2 * len(Y), -1)
-
-    def _boundary_w(self) -> np.ndarray:
-        """<w, psi_j> on the boundary elements (P0 traction space), graded Gauss (w is
-        like r log r where interior cell edges meet Gamma)."""
-        bem, cx, mesh = self.bem, self.cells, self.bem.mesh
-        nW, nc3 = 2 * bem.W_space.ndof, 3 * cx.ncells
-        s, w = _graded_rule()
-        Yb = (mesh.a[:, None] + s[None, :, None] * (mesh.b - mesh.a)[:, None]).reshape(-1, 2)
-        Nw, _ = newton_operators(cx, Yb, self.E, self.nu, gradient=False)
-        Nw = Nw.reshape(mesh.n_elements, len(s), 2, nc3)
-        Gw = np.zeros((nW, nc3))
-        wdof = bem.W_space.elem_dofs[:, 0]
-        for c in range(2):
-            Gw[2 * wdof + c] = np.einsum("eqt,q,e->et", Nw[:, :, c], w, mesh.lengths)
-        return Gw
 
     # ------------------------------------------------------------------ fields
     def tau(self, eps_p: np.ndarray) -> np.ndarray:
@@ -396,7 +215,7 @@ class ElastoPlasticBE:
     def implicit_response(self, u: np.ndarray, tol: float = 1e-10, max_iter: int = 50):
         """Backward Euler plastic state at u: the cell strains e solve
         F(e) = e - B u - M tau(RM(e)) = 0 (RM the return map from the committed history,
-        tau its initial stress), by :func:`hpfebe.solvers.nonlinear.newton` with Armijo line search
+        tau its initial stress), by :func:`hpfebe.solvers.newton` with Armijo line search
         on ||F||^2 (semismooth: the plastic set changes between iterates).  Its Jacobian
         I - M D (D = d tau / d e = (C - C_alg) in-plane, zero on elastic cells) is reduced
         to the plastic cells: (I - M_pp D_p) de_p = -F_p, de_e = -F_e + M_ep D_p de_p.
@@ -456,7 +275,7 @@ class ElastoPlasticBE:
         """Algorithm 4.2 within one load step: u^(k+1) = solve(G(eps_p^(k))) (the
         elastic solve with the plastic force on the right-hand side, a callable
         returning u), eps_p^(k+1) from the return map at u^(k+1); fixed point of
-        :func:`hpfebe.solvers.nonlinear.fixed_point` on eps_p.  Commits the converged state and
+        :func:`hpfebe.solvers.fixed_point` on eps_p.  Commits the converged state and
         returns (u, SolverInfo)."""
         state = {}
 
@@ -483,7 +302,7 @@ class ElastoPlasticBE:
 
 class _CellStrainProblem:
     """The inner problem of :meth:`ElastoPlasticBE.implicit_response` for
-    :func:`hpfebe.solvers.nonlinear.newton`: x = cell strains e (3 ncell), residual
+    :func:`hpfebe.solvers.newton`: x = cell strains e (3 ncell), residual
     F(e) = e - b - M tau(RM(e)), merit ||F||^2 / 2, key = the plastic set; the scale of
     the stopping test is max|e| + the yield strain sigma_Y / E (sigma_Y capped at 1e-3 E,
     :attr:`J2Material.stress_floor`)."""
@@ -643,7 +462,6 @@ def rectangle_work_piece(box, nx: int, ny: int, material: J2Material,
     (``cells="crossed"``: each split into four triangles, :func:`crossed_cells`);
     ``cell_rows``: only the top ``cell_rows`` rows of cells (the region where plastic
     strain can appear; default all ny)."""
-    from ..fem.elasticity import rectangle_mesh
     for name, v in (("nx", nx), ("ny", ny)):
         if isinstance(v, bool) or int(v) != v or v < 1:
             raise ValueError(f"{name} must be a positive integer, got {v!r}")

@@ -21,6 +21,13 @@ Return map (backward Euler, Section 4.2.5), with s the slip bound:
               traction),
     slip   <- g_t - eps_t t_t      after a converged step (:func:`updated_slip`).
 
+The return map is :func:`tresca_return` (compiled, one point) and
+:func:`friction_projection` (arrays): the penalty path applies it to t_trial, the mortar
+path (Algorithms 4.4, 4.5: :mod:`hpfebe.solvers.uzawa`, :mod:`hpfebe.solvers.semismooth`)
+to the Uzawa multiplier and the nodal friction traction, with the same sign convention
+(the traction, or lambda, has the sign of the slip; :func:`normal_projection` the
+positive part of the normal law).
+
 Consistent linearisation (4.35), pointwise (generalised derivatives):
 
     d p_n = (1/eps_n) [d_n >= 0] d(d_n)                (sign(0) := 1, Remark 4.2.2)
@@ -34,6 +41,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from numba import njit
 
 OPEN, STICK, SLIP = 0, 1, 2
 STATE_NAMES = {OPEN: "open", STICK: "stick", SLIP: "slip"}
@@ -109,13 +117,44 @@ def penalty_friction(penetration, g_t, slip, eps_n: float, eps_t: float, mu_f=No
     stick = carries & (np.abs(trial) <= s)
     slipping = carries & ~stick
     sg = np.sign(trial)
-    t_t = np.where(stick, trial, np.where(slipping, s * sg, 0.0))
+    t_t = np.where(carries, friction_projection(trial, s), 0.0)     # the return map
     dt_t = np.where(stick, 1.0 / eps_t, 0.0)
     dt_n = zero if F is not None else np.where(slipping, mu_f * sg * dp_n, 0.0)
     state = np.full(p_n.shape, OPEN, dtype=np.int8)
     state[stick] = STICK
     state[slipping] = SLIP
     return LawState(p_n, t_t, trial, np.array(s, dtype=float), state, dp_n, dt_t, dt_n)
+
+
+@njit(cache=True)
+def tresca_return(trial, bound):
+    """The return map of the friction law at one point, compiled: t = trial if
+    |trial| <= bound (stick), bound sign(trial) otherwise (slip); NaN propagates.  The
+    mortar path applies it to the Uzawa multiplier (Algorithm 4.4, lambda_new =
+    P_Lambda(lambda + rho F (U_t - Q_t)) = tresca_return(., 1), the sign of lambda that
+    of the slip as t_t's) in :func:`hpfebe.solvers.uzawa.tresca_uzawa`; the same
+    branches as :func:`penalty_friction`'s stick / slip cases."""
+    if trial > bound:
+        return bound
+    if trial < -bound:
+        return -bound
+    return trial
+
+
+def friction_projection(trial, bound) -> np.ndarray:
+    """:func:`tresca_return` on arrays (numpy): the projection of a trial friction traction
+    onto [-bound, bound] (Tresca: bound F; Coulomb: mu_f p_n), trial where |trial| <=
+    bound (stick), bound sign(trial) otherwise (slip), as the penalty law
+    (:func:`penalty_friction`), the global Uzawa (Algorithm 4.5, step 3) and the
+    semismooth Newton method of the mortar path use it."""
+    trial = np.asarray(trial, dtype=float)
+    return np.where(np.abs(trial) <= bound, trial, bound * np.sign(trial))
+
+
+def normal_projection(trial) -> np.ndarray:
+    """The projection of a trial contact pressure onto p_n >= 0, max(0, trial) (Algorithm
+    4.5, step 3, the positive part of the normal law)."""
+    return np.maximum(0.0, trial)
 
 
 def updated_slip(g_t, law: LawState, eps_t: float) -> np.ndarray:

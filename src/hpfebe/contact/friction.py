@@ -18,7 +18,7 @@ Gamma_C; the contact state (pressure, stick/slip, slip history) lives at these p
 so the residual is piecewise linear in U and the Newton matrix its exact generalised
 derivative.
 
-Newton (:func:`hpfebe.solvers.nonlinear.newton` in the load path of Algorithm 4.1, load factor
+Newton (:func:`hpfebe.solvers.newton` in the load path of Algorithm 4.1, load factor
 lambda_j = j / N scaling the load and the obstacle motion; the gap is geometry):
 backtracking line search on the energy (Tresca; the equation is its gradient) or on
 ||R||_2 (Coulomb, no potential); max-norm residual, stopping when
@@ -35,7 +35,9 @@ import numpy as np
 from ..bodies.body import RigidObstacle, against_obstacle
 from ..constitutive.laws import OPEN, SLIP, STATE_NAMES, STICK  # noqa: F401  (re-exported)
 from ..constitutive.laws import positive
-from .two_body import ContactResult, TwoBodyContact
+from .result import ContactResult
+from .settings import ContactSettings
+from .two_body import TwoBodyContact
 
 LAWS = ("tresca", "coulomb")
 FrictionResult = ContactResult
@@ -97,7 +99,8 @@ def solve_friction(bem, eps_n: float, eps_t: float, gap, friction: str = "tresca
     body, fixed, f = against_obstacle(bem, S, contact_label, dirichlet_label, load)
     pr = TwoBodyContact(body, RigidObstacle(gap, obstacle_slip), contact_label,
                         eps_n=eps_n, eps_t=eps_t, nq=nq, **bound)
-    return pr.solve(f, fixed, None, np.arange(1, load_steps + 1) / load_steps, rtol=tol,
-                    max_iter=max_iter, line_search=True, norm="max",
-                    merit="energy" if law == "tresca" else "residual",
-                    predictor=predictor, initial=initial)
+    return pr.solve(f, fixed, None, np.arange(1, load_steps + 1) / load_steps,
+                    ContactSettings(rtol=tol, max_iter=max_iter, line_search=True,
+                                    norm="max", predictor=bool(predictor),
+                                    merit="energy" if law == "tresca" else "residual"),
+                    initial=initial)

@@ -1,9 +1,9 @@
 """Limits and diagnostics of the penalty contact problem of Section 3.2.5.
 
-The benchmark body (thesis lines 8540-8640): Omega = [-1,1]^2 with Gamma_C = the bottom
-side (n = (0, -1)), Gamma_N = the vertical sides (traction free), Gamma_D = the top side
-(u = 0), discretised with S_hat of :class:`hpfebe.bem.lame.LameBEM`.  For the penalty
-problem (3.57)
+The benchmark body (thesis lines 8540-8640, :func:`hpfebe.scenes.penalty.square_body`):
+Omega = [-1,1]^2 with Gamma_C = the bottom side (n = (0, -1)), Gamma_N = the vertical
+sides (traction free), Gamma_D = the top side (u = 0), discretised with S_hat of
+:class:`hpfebe.bem.lame.LameBEM`.  For the penalty problem (3.57)
 
     G(U) = S_hat U + (1/eps) int_{Gamma_C} (U_n - g_h)_+ v_n ds = 0   (free dofs)
 
@@ -38,28 +38,14 @@ from dataclasses import dataclass, replace
 import numpy as np
 from scipy.optimize import brentq
 
-from ..bem.lame import LameBEM
-from ..geometry import BoundaryMesh
 from ..constitutive.materials import lame_constants
 from .penalty import PenaltyResult, penalty_residual, solve_penalty
 
-__all__ = ["MACHEPS", "SQUARE", "SQUARE_LABELS", "PenaltyCheck", "backward_error",
-           "check_penalty_solution", "constrained_limit", "saturation_index",
-           "singular_exponent", "solve_penalty_checked", "square_body"]
+__all__ = ["MACHEPS", "PenaltyCheck", "backward_error", "check_penalty_solution",
+           "constrained_limit", "saturation_index", "singular_exponent",
+           "solve_penalty_checked"]
 
 MACHEPS = float(np.finfo(float).eps)
-
-#: the benchmark square [-1,1]^2 and its side labels (bottom, right, top, left)
-SQUARE = ((-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0))
-SQUARE_LABELS = ("C", "N", "D", "N")
-
-
-def square_body(n: int, E: float, nu: float, plane: str = "strain", p: int = 1) -> LameBEM:
-    """The Section 3.2.5 body: [-1,1]^2, n elements of degree p per side, Gamma_C bottom,
-    Gamma_N the vertical sides, Gamma_D top."""
-    mesh = BoundaryMesh.polygon(SQUARE, n=n, p=p, labels=list(SQUARE_LABELS))
-    return LameBEM(mesh, E, nu, plane=plane)
-
 
 # --------------------------------------------------------------------------- corner
 def singular_exponent(nu: float, plane: str = "strain", omega: float = math.pi / 2) -> float:

@@ -2,8 +2,8 @@
 at each load factor the Newton problem (residual R = f_int(U) + f_c(U) - F_ext on the free
 dofs, its merit, force scale and contact pattern), its start (the last converged state
 with the new Dirichlet values), the commit of the slip and of the bodies' history after
-convergence (the :class:`hpfebe.solvers.nonlinear.LoadStep` and
-:class:`hpfebe.solvers.nonlinear.NewtonProblem` protocols), and the bonded predictor."""
+convergence (the :class:`hpfebe.solvers.LoadStep` and
+:class:`hpfebe.solvers.NewtonProblem` protocols), and the bonded predictor."""
 
 from __future__ import annotations
 
@@ -17,19 +17,13 @@ import scipy.sparse.linalg as spla
 
 from ..solvers import Iterate, SingularStep, SolverInfo
 from ..constitutive.laws import STATE_NAMES, updated_slip
-
-MERITS = ("residual", "energy")
-#: column orderings of the sparse LU (:meth:`LoadSteps._factor`): SuperLU's default
-#: COLAMD, or minimum degree on A^T + A with symmetric-mode (diagonal-preferring)
-#: threshold pivoting - about 1.7x faster on the stamping systems (Q1 work piece, FE or
-#: BE stamp, 8e3 dofs), but with other round-off in every Newton step
-LU_ORDERINGS = ("COLAMD", "MMD_AT_PLUS_A")
+from .settings import ContactSettings
 
 
 class LoadSteps:
     """The load steps of :meth:`TwoBodyContact.solve`: the Newton problem at a load
     factor (residual R = K U + f_c(U) - F_ext on the free dofs), its start, and the
-    commit of the slip after a converged step (:class:`hpfebe.solvers.nonlinear.LoadStep`)."""
+    commit of the slip after a converged step (:class:`hpfebe.solvers.LoadStep`)."""
 
     #: factorisations of the sparse Newton matrix kept for reuse (:meth:`_factor`): at
     #: most this many, and at most LU_CACHE_NNZ nonzeros in their factors together
@@ -37,17 +31,10 @@ class LoadSteps:
     LU_CACHE = 8
     LU_CACHE_NNZ = 100_000_000
 
-    def __init__(self, pr, f_ext, fixed_dofs, fixed_values, merit, initial,
-                 lu_ordering: str = "COLAMD", linear_solver: str = "lu"):
-        if merit not in MERITS:
-            raise ValueError(f"merit must be one of {MERITS}, got {merit!r}")
-        if lu_ordering not in LU_ORDERINGS:
-            raise ValueError(f"lu_ordering must be one of {LU_ORDERINGS}, got "
-                             f"{lu_ordering!r}")
-        self.lu_ordering = lu_ordering
-        if linear_solver not in LINEAR_SOLVERS:
-            raise ValueError(f"linear_solver must be one of {LINEAR_SOLVERS}, got "
-                             f"{linear_solver!r}")
+    def __init__(self, pr, f_ext, fixed_dofs, fixed_values, settings: ContactSettings,
+                 initial=None):
+        merit, linear_solver = settings.merit, settings.linear_solver
+        self.settings, self.lu_ordering = settings, settings.lu_ordering
         if linear_solver == "woodbury" and (pr.dense or pr.exact is not None or not all(
                 getattr(b, "linear", False) for b in pr.bodies.values())):
             raise ValueError("linear_solver='woodbury' needs linear bodies, an FE body "
@@ -75,8 +62,15 @@ class LoadSteps:
         if initial is not None:
             self._continue_from(initial)
         self.f, self.w = self.f0, self.w0
-        self.detect_cycling = False
+        # cycling of the contact state is detected along a line search
+        self.detect_cycling = settings.line_search
         self._lu = {}      # factorisations of Newton matrices seen (:meth:`_factor`)
+
+    def newton_options(self) -> dict:
+        """The keywords of :func:`hpfebe.solvers.newton` for these steps: the
+        settings' stopping test and line search, the bonded predictor if asked for."""
+        return dict(self.settings.newton_options(),
+                    predictor=self.bonded_predictor if self.settings.predictor else None)
 
     def _continue_from(self, initial) -> None:
         pr = self.pr
@@ -189,6 +183,10 @@ class LoadSteps:
         dx = np.zeros(pr.ndofs)
         dx[free] = d
         return dx
+
+    def forget_factorisations(self) -> None:
+        """Empty the cache of :meth:`_factor` (the factorisations of the steps so far)."""
+        self._lu = {}
 
     def _factor(self, Af: sp.csc_matrix):
         """splu(Af), reused when the same matrix (bit for bit) was factorised before in
@@ -322,12 +320,6 @@ def _ordered_splu(pr, Af: sp.csc_matrix, pattern):
     while len(orders) > ORDER_CACHE:
         orders.pop(next(iter(orders)))
     return lu
-
-
-#: Newton solvers of a system with an FE body (:meth:`LoadSteps._solve`): "lu" a sparse
-#: LU of every Newton matrix; "woodbury" one factorisation of the bodies' stiffness per
-#: problem and the contact terms by the Sherman-Morrison-Woodbury formula (linear bodies)
-LINEAR_SOLVERS = ("lu", "woodbury")
 
 
 class WoodburySolver:

@@ -6,10 +6,11 @@ contact / mortar side) and a J2 elastoplastic FE body 2 (the work piece,
 The machinery is that of the hp-mortar BEM (:mod:`hpfebe.contact.mortar`):
 :class:`FEMortarContact` is a :class:`~hpfebe.contact.mortar.MortarContact` whose body 1
 is the FE stiffness of the stamp condensed onto its contact dofs
-(:class:`~hpfebe.contact.mortar.CondensedBody`, one Cholesky factorisation, built once
+(:class:`~hpfebe.bodies.condensed.CondensedBody`, one Cholesky factorisation, built once
 and reused by every DtN iteration and every damping pair), so the frictional contact
 problem of step 4 (Uzawa, Algorithm 4.4, with Polyak's projected CG for the inner QP),
-the frame, the gap and the Lobatto weights are inherited unchanged.  The traces of the
+the reaction of step 5, the frame, the gap and the Lobatto weights are inherited
+unchanged, and the DtN iteration is the one of :func:`hpfebe.solvers.dtn.dtn`.  The traces of the
 Q1 bodies on their boundaries are the continuous P1 spaces of
 :class:`~hpfebe.spaces.ContinuousSpace` on a :class:`~hpfebe.geometry.BoundaryMesh`
 through the FE boundary vertices (:func:`fe_trace_mesh`), and the data transfer is the
@@ -21,7 +22,7 @@ elastoplastic one (Remark 4.3.5: the nonlinearities are separated),
     f_int(U^2_k) = -P_k on Gamma^2_C,   U^2_k = u_D on Gamma^2_D,                   (4.88)
 
 one backward-Euler step (4.38)-(4.43) from the committed (virgin) history of the work
-piece, solved by :func:`hpfebe.solvers.nonlinear.newton` on the body's
+piece, solved by :func:`hpfebe.solvers.newton` on the body's
 :class:`~hpfebe.fem.plastic_body.DisplacementSteps` problem (consistent tangent,
 Armijo line search; each Newton system by the banded Cholesky factorisation of the
 symmetric positive definite tangent, :class:`_BandSteps`, 15-18x faster than SuperLU on the
@@ -31,11 +32,13 @@ DtN iteration and every damping pair solves the same one-step problem.
 
 :meth:`FEMortarContact.monolithic` (beyond the thesis) solves the same discrete problem
 at once: the stamp, the work piece and the nodal contact forces by a semismooth Newton
-method on the complementarity functions of the normal contact and the Tresca law.
+method on the complementarity functions of the normal contact and the Tresca law
+(:class:`MonolithicKKT`).  The scene of Section 4.4 is :mod:`hpfebe.scenes.section44`.
 """
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from types import SimpleNamespace
 
 import numpy as np
@@ -43,34 +46,18 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 from scipy.linalg import lapack
 
+from ..bodies.condensed import CondensedBody
+from ..constitutive.j2 import dev, tensor_norm
 from ..coupling.mortar import MortarProjection
 from ..fem.elasticity import ElasticBody
 from ..fem.plastic_body import DisplacementSteps, ElastoPlasticFE
-from ..constitutive.j2 import dev, tensor_norm
 from ..geometry import BoundaryMesh
-from ..solvers import Iterate, SingularStep, SolverInfo, fixed_point, newton
+from ..solvers import Iterate, SingularStep, SolverInfo, newton
+from ..solvers.dtn import DtNSettings, DtNState, dtn, transfer_maps
 from ..spaces import ContinuousSpace
-from .mortar import (CondensedBody, MortarContact, MortarSolution, _check_omega,
-                     _check_pos, ray_gap)
+from .mortar import MortarContact, MortarSolution, _check_pos, ray_gap
 
 SIDES = ("bottom", "right", "top", "left")
-
-#: Readings of the DtN stopping rule (Algorithm 4.3, step 7: "stop if ||P^k - P^k-1|| <=
-#: TOL_DtN ||P^k-1||"), recorded per iteration by :meth:`FEMortarContact.dtn` in
-#: ``info.counts["readings"]``: the quantity (P: the transferred traction functional on
-#: Gamma^2_C; U2: the work piece's displacement of step 2), the norm (l2 / max of the
-#: coefficient vector, L2(Gamma_C) of the function M2^-1 P, the elastic energy norm of
-#: U2, U2 on Gamma^2_C) and the reference (the previous iterate - the printed rule -, the
-#: new one - :func:`hpfebe.solvers.nonlinear.fixed_point`'s -, or the first nonzero P).
-#: "P_n_l2_prev": the normal components of P alone (a test on the contact pressure).
-#: "P_t_l2_prev" is no reading but a bound: the tangential components of P's increment
-#: alone, relative to ||P^k-1|| (<= P_l2_prev: the printed rule cannot stop before it
-#: falls below TOL).  Where the stamp slides, step 6 relaxes the tangential traction
-#: alone (R1_t = F w lambda, |lambda| = 1, does not change), so this quantity contracts by
-#: exactly 1 - omega_N per iteration.
-READINGS = ("P_l2_prev", "P_l2_new", "P_max_prev", "P_L2gamma_prev", "P_l2_first",
-            "U2_l2_prev", "U2_max_prev", "U2_energy_prev", "U2_contact_prev", "P_n_l2_prev",
-            "P_t_l2_prev")
 
 
 # --------------------------------------------------------------------------- traces
@@ -211,6 +198,24 @@ class _BandSteps(DisplacementSteps):
 
 
 # --------------------------------------------------------------------------- problem
+@dataclass(frozen=True)
+class NeumannSettings:
+    """Newton for step 2 of Algorithm 4.3 on the elastoplastic body 2, (4.88): stop at
+    ||R||_inf <= ``tol`` x (force scale + :attr:`FEMortarContact.force_floor`), at most
+    ``max_iter`` iterations."""
+
+    tol: float = 1e-8
+    max_iter: int = 30
+
+    def __post_init__(self):
+        if not (np.isfinite(self.tol) and self.tol > 0):
+            raise ValueError(f"newton tol must be positive, got {self.tol!r}")
+        if isinstance(self.max_iter, bool) or int(self.max_iter) != self.max_iter or \
+                self.max_iter < 1:
+            raise ValueError(f"newton max_iter must be a positive integer, got "
+                             f"{self.max_iter!r}")
+
+
 class FEMortarContact(MortarContact):
     """An elastic FE stamp (body 1) and an elastoplastic FE work piece (body 2) coupled
     by the mortar projection (Section 4.4).
@@ -327,44 +332,50 @@ class FEMortarContact(MortarContact):
         return u
 
     # ---------------------------------------------------------------- DtN
-    def dtn(self, omega_D: float, omega_N: float, rho: float = 8.264e5, tol: float = 1e-6,
-            tol_U: float = 1e-6, max_iter: int = 200, max_uzawa: int = 2000,
-            divergence: float = 1e6, rho_relative: bool = False,
-            newton_tol: float = 1e-8, newton_max_iter: int = 30,
-            coupling_tol: float = 1e-3, transfer: str = "functional",
-            F: float | None = None) -> MortarSolution:
-        """Algorithm 4.3 with the elastoplastic Neumann problem (Remark 4.3.5):
+    def neumann_step(self, load, state: DtNState | None = None):
+        """Step 2 of Algorithm 4.3 as :func:`hpfebe.solvers.dtn.dtn` calls it:
+        :meth:`neumann` under the functional ``load``, warm-started from ``state.u2``,
+        with the Newton settings ``state.data["newton"]`` (default
+        :class:`NeumannSettings`).  Returns (U2 on all FE dofs, its values on the dofs
+        c2, the Newton SolverInfo - one that did not converge named "Neumann problem
+        (Newton)": it ends the DtN iteration with its reason)."""
+        u0, newton = (None, None) if state is None else (state.u2, state.data.get("newton"))
+        newton = NeumannSettings() if newton is None else newton
+        u2, info = self.neumann(load, u0, newton.tol, newton.max_iter)
+        if not info.converged:
+            info = SolverInfo(False, f"Neumann problem (Newton): {info.reason}",
+                              steps=[info])
+        return u2, u2[self.c2], info
 
-        2. f_int(U2_k) = L2 - P_k (:meth:`neumann`, Newton, tolerance ``newton_tol``),
-        3. Q_k = (1 - omega_D) Q_{k-1} + omega_D D^-1 B U2_k,
-        4. the stamp's frictional contact problem against Q_k with given friction F
-           (Uzawa, Algorithm 4.4, step ``rho`` - absolute unless ``rho_relative``,
-           tolerance ``tol_U``; multiplier and QP warm-started from the last DtN
-           iteration),
-        5. R1 = S1 U1 - L1 on Gamma^1_C,
-        6. P_{k+1} = (1 - omega_N) P_k + omega_N B^T D^-T R1,
-        7. stop if ||P_{k+1} - P_k||_2 <= TOL ||P_{k+1}||_2 (:func:`fixed_point`; the
-           thesis divides by ||P_k||, the previous iterate: the two thresholds differ by
-           a factor 1 + O(TOL), the counts are the same - measured on Table 4.2, every
-           reading in ``info.counts["readings"]``, :data:`READINGS`; growth of the
-           increment by ``divergence``, a failed Newton or Uzawa solve or ``max_iter``
-           end it with the reason); converged only if also the obstacle matches the
-           work piece, ||Q_n - (pi U2)_n||_inf <= ``coupling_tol`` ||(pi U2)_n||_inf
-           (``info.backward_error``) and the work piece's equilibrium residual under P
-           (:meth:`kkt_residual`, ``equilibrium2``) is <= ``coupling_tol``.
+    def dtn(self, settings: DtNSettings, newton: NeumannSettings = NeumannSettings(),
+            coupling_tol: float = 1e-3, F: float | None = None, hook=None
+            ) -> MortarSolution:
+        """Algorithm 4.3 with the elastoplastic Neumann problem (Remark 4.3.5), by
+        :func:`hpfebe.solvers.dtn.dtn` (its steps, the stopping rule and the readings
+        ``settings.transfer`` are described there - the fixed point of "function" is not
+        the consistent discrete problem; the settings of Section 4.4:
+        :func:`hpfebe.scenes.section44.dtn_settings`): step 2 f_int(U2_k) = L2 - P_k
+        (:meth:`neumann_step`, Newton ``newton``), step 4 the stamp's frictional contact
+        problem against Q_k with given friction F (Uzawa, Algorithm 4.4,
+        ``settings.uzawa``: step rho - absolute unless ``relative`` -; multiplier and QP
+        warm-started from the last DtN iteration; :meth:`contact_step`), step 5 R1 =
+        S1 U1 - L1 on Gamma^1_C (:meth:`reaction`), step 6 as printed
+        (``settings.relaxation`` "convex").  Step 7 stops at ||P_{k+1} - P_k||_2 <= TOL
+        ||P_{k+1}||_2; the thesis divides by ||P_k||, the previous iterate: the two
+        thresholds differ by a factor 1 + O(TOL), the counts are the same (measured on
+        Table 4.2, every reading recorded by a ``hook``).  Converged only if also the
+        obstacle matches the work piece, ||Q_n - (pi U2)_n||_inf <= ``coupling_tol``
+        ||(pi U2)_n||_inf (``info.backward_error``), and the work piece's equilibrium
+        residual under P (:meth:`kkt_residual`, ``equilibrium2``) is <= ``coupling_tol``.
 
-        ``newton_tol``: the Newton tolerance of step 2 (||R||_inf <= newton_tol x (force
-        scale + :attr:`force_floor`)); the thesis's TOL_N = 1e-4 in this norm leaves
-        the Neumann solutions too inexact for TOL_DtN = 1e-6 (the DtN increments
-        stagnate at ~4e-5), hence the default 1e-8 (Newton converges quadratically:
-        one more iteration).
-
-        ``transfer``: "functional" (consistent: P = B^T D^-T R1 is the force on body 2)
-        or "function" (the literal reading of steps 5-6 and (4.88), as
-        :meth:`MortarContact.dtn`: R1 = D^-1 r1 and P functions, the load of step 2 the
-        L2 pairing M2 P; its fixed point is not the consistent discrete problem).
-
-        ``F``: a given friction bound replacing the scene's (e.g. 0: frictionless).
+        ``newton``: step 2 to ||R||_inf <= tol x (force scale + :attr:`force_floor`);
+        the thesis's TOL_N = 1e-4 in this norm leaves the Neumann solutions too inexact
+        for TOL_DtN = 1e-6 (the DtN increments stagnate at ~4e-5), hence the default
+        1e-8 (Newton converges quadratically: one more iteration).  ``F``: a given
+        friction bound replacing the scene's (e.g. 0: frictionless).  ``hook``: called
+        with the :class:`~hpfebe.solvers.dtn.DtNState` after every DtN iteration (P_k,
+        P_k+1, U2_k-1 - None in the first -, U2_k), e.g. the readings of the stopping
+        rule, :class:`hpfebe.scenes.section44.DtNReadings`.
 
         ``info.steps[k]``: the inner SolverInfo of DtN iteration k + 1, its ``counts``
         the Uzawa and Newton iterations; ``info.counts["relative_increments"]``: the
@@ -372,85 +383,66 @@ class FEMortarContact(MortarContact):
         run stopped at a looser TOL is its first entry <= TOL), ``P_norms`` the
         ||P_k+1||.  ``extra``: the FE vectors ``u1``, ``u2``, the force of step 2 on
         body 2 ``force2`` and the work piece's stress fields (:meth:`work_fields`)."""
-        _check_omega("omega_D", omega_D)
-        _check_omega("omega_N", omega_N)
-        _check_pos("rho", rho)
-        if transfer not in ("functional", "function"):
-            raise ValueError(f"transfer must be 'functional' or 'function', got "
-                             f"{transfer!r}")
-        rho = self.rho_step(rho, rho_relative)
         bound = None
         if F is not None:
             if not (np.isfinite(F) and F >= 0):
                 raise ValueError(f"F must be >= 0, got {F!r}")
             bound = np.full(self.nc, float(F))
-        m = self.mortar
-        load2 = m.pair2 if transfer == "function" else (lambda P: P)
-        to_P = (lambda R1: m.adjoint(m.riesz(R1))) if transfer == "function" else m.adjoint
-        st = dict(Q=np.zeros(2 * self.nc), lam=np.zeros(self.nc), x=None, u2=None, pn=[],
-                  first=None, readings={k: [] for k in READINGS})
+        norms = []
 
-        def update(P):
-            u2, ninfo = self.neumann(load2(P), st["u2"], newton_tol, newton_max_iter)
-            if not ninfo.converged:
-                return P, SolverInfo(False, f"Neumann problem (Newton): {ninfo.reason}",
-                                     steps=[ninfo])
-            u2_old, st["u2"] = st["u2"], u2
-            Q = (1.0 - omega_D) * st["Q"] + omega_D * m.project(u2[self.c2])
-            x, lam, uinfo = self.uzawa(Q, rho, tol_U, max_uzawa, st["lam"], st["x"],
-                                       bound=bound)
-            st.update(Q=Q, lam=lam, x=x)
-            R1 = self.body1.reaction(self.R.T @ x)
+        def iteration(st: DtNState) -> SolverInfo:
+            """The inner SolverInfo of one DtN iteration (Newton of step 2, Uzawa of
+            step 4), ||P_k+1|| and the caller's hook."""
+            ninfo, uinfo = st.neumann_info, st.contact_info
             inner = SolverInfo(uinfo.converged, uinfo.reason, uinfo.iterations,
                                steps=[ninfo, uinfo],
                                counts=dict(uzawa=uinfo.iterations,
                                            newton=ninfo.iterations))
             if not uinfo.converged:
                 inner.reason = f"Uzawa: {uinfo.reason}"
-            P_new = (1.0 - omega_N) * P + omega_N * to_P(R1)
-            st["pn"].append(float(np.linalg.norm(P_new)))
-            if st["first"] is None:
-                st["first"] = P_new
-            self._record_readings(st["readings"], P, P_new, st["first"], u2_old, u2)
-            return P_new, inner
+            norms.append(float(np.linalg.norm(st.P_new)))
+            if hook is not None:
+                hook(st)
+            return inner
 
-        P, info = fixed_point(update, np.zeros(self.c2.size), tol, max_iter, norm=2,
-                              divergence=divergence)
-        return self._dtn_solution(P, info, st, rho, load2, newton_tol, newton_max_iter,
+        P, info, st = dtn(self, settings, iteration, bound=bound, data=dict(newton=newton))
+        rho = self.rho_step(settings.uzawa.rho, settings.uzawa.relative)
+        return self._dtn_solution(P, info, st, norms, rho, settings.transfer, newton,
                                   coupling_tol)
 
-    def _dtn_solution(self, P, info: SolverInfo, st: dict, rho: float, load2, newton_tol,
-                      newton_max_iter, coupling_tol) -> MortarSolution:
+    def _dtn_solution(self, P, info: SolverInfo, st: DtNState, norms: list, rho: float,
+                      transfer: str, newton: NeumannSettings,
+                      coupling_tol: float) -> MortarSolution:
         """The end of :meth:`dtn`: iteration counts, U2 of the final P, and the backward
         error of the transfer (a converged P must make the obstacle Q the work piece)."""
         m = self.mortar
+        load2, _ = transfer_maps(m, transfer)
         info.counts = dict(
             uzawa_first=info.steps[0].counts.get("uzawa", 0) if info.steps else 0,
             uzawa_total=int(sum(s.counts.get("uzawa", 0) for s in info.steps)),
             newton_total=int(sum(s.counts.get("newton", 0) for s in info.steps)),
             rho=rho, relative_increments=[
-                r / max(n, np.finfo(float).tiny) for r, n in zip(info.residuals, st["pn"])],
-            readings=st["readings"], P_norms=st["pn"])
-        u2 = st["u2"] if st["u2"] is not None else self.elastic_start(
-            np.zeros(self.work.ndofs))
+                r / max(n, np.finfo(float).tiny) for r, n in zip(info.residuals, norms)],
+            P_norms=norms)
+        u2 = st.u2 if st.u2 is not None else self.elastic_start(np.zeros(self.work.ndofs))
         if info.converged:                       # U2 of the final P (step 2 once more)
-            u2, ninfo = self.neumann(load2(P), u2, newton_tol, newton_max_iter)
+            u2, ninfo = self.neumann(load2(P), u2, newton.tol, newton.max_iter)
             if not ninfo.converged:
                 info.converged, info.reason = False, f"final Neumann solve: {ninfo.reason}"
         # backward error of the transfer: at a fixed point Q_n = (pi U2)_n (step 3; the
         # tangential Q_t enters only through the slip direction where the stamp slides);
         # a P that stops changing because the stamp has lost contact (P = 0 twice) is no
         # solution
-        qn, pn = self.frame(st["Q"])[0], self.frame(m.project(u2[self.c2]))[0]
+        qn, pn = self.frame(st.Q)[0], self.frame(m.project(u2[self.c2]))[0]
         info.backward_error = float(np.abs(qn - pn).max() / max(np.abs(pn).max(), 1e-300))
         if info.converged and info.backward_error > coupling_tol:
             info.converged = False
             info.reason = (f"no solution: P stopped changing but the obstacle Q_n differs "
                            f"from (pi U2)_n by {info.backward_error:.1e} (relative) > "
                            f"coupling_tol = {coupling_tol:g}")
-        x = st["x"] if st["x"] is not None else np.zeros(2 * self.nc)
+        x = st.x if st.x is not None else np.zeros(2 * self.nc)
         u1 = self.body1.expand(self.R.T @ x)
-        sol = MortarSolution(u1[self.c1], u2[self.c2], st["lam"], st["Q"], P, x, info,
+        sol = MortarSolution(u1[self.c1], u2[self.c2], st.lam, st.Q, P, x, info,
                              extra=dict(u1=u1, u2=u2, force2=load2(P),
                                         fields=self.work_fields(u2)))
         # backward error of step 2, independent of the Newton test and its floor: the
@@ -462,131 +454,29 @@ class FEMortarContact(MortarContact):
                            f"(relative) > coupling_tol = {coupling_tol:g}")
         return sol
 
-    def _record_readings(self, out: dict, P_old, P_new, P_first, u2_old, u2) -> None:
-        """Append the relative increment of DtN iteration k under every reading of the
-        stopping rule (:data:`READINGS`) to ``out`` (inf where the reference is zero or
-        not yet defined: the first iteration has P_0 = 0 and no previous U2)."""
-        def rel(num, den):
-            return float(num / den) if den > 0 else np.inf
-
-        dP = P_new - P_old
-        if not hasattr(self, "_m2_lu"):
-            self._m2_lu = spla.splu(sp.csc_matrix(self.mortar.M2))
-            self._K2e = self.work.K.tocsr()
-
-        def l2_gamma(v):                    # ||M2^-1 v||_L2(Gamma_C) of a functional v
-            V = v.reshape(-1, 2)
-            return float(np.sqrt(max((self._m2_lu.solve(V) * V).sum(), 0.0)))
-
-        def energy(v):
-            return float(np.sqrt(max(v @ (self._K2e @ v), 0.0)))
-
-        out["P_l2_prev"].append(rel(np.linalg.norm(dP), np.linalg.norm(P_old)))
-        out["P_l2_new"].append(rel(np.linalg.norm(dP), np.linalg.norm(P_new)))
-        out["P_max_prev"].append(rel(np.abs(dP).max(), np.abs(P_old).max()))
-        out["P_L2gamma_prev"].append(rel(l2_gamma(dP), l2_gamma(P_old)))
-        out["P_l2_first"].append(rel(np.linalg.norm(dP), np.linalg.norm(P_first)))
-        out["P_t_l2_prev"].append(rel(np.linalg.norm(dP.reshape(-1, 2)[:, self.t2]),
-                                      np.linalg.norm(P_old)))
-        out["P_n_l2_prev"].append(rel(np.linalg.norm(dP.reshape(-1, 2)[:, 1 - self.t2]),
-                                      np.linalg.norm(P_old.reshape(-1, 2)[:, 1 - self.t2])))
-        if u2_old is None:
-            for k in ("U2_l2_prev", "U2_max_prev", "U2_energy_prev", "U2_contact_prev"):
-                out[k].append(np.inf)
-            return
-        dU = u2 - u2_old
-        out["U2_l2_prev"].append(rel(np.linalg.norm(dU), np.linalg.norm(u2_old)))
-        out["U2_max_prev"].append(rel(np.abs(dU).max(), np.abs(u2_old).max()))
-        out["U2_energy_prev"].append(rel(energy(dU), energy(u2_old)))
-        out["U2_contact_prev"].append(rel(np.linalg.norm(dU[self.c2]),
-                                          np.linalg.norm(u2_old[self.c2])))
-
     # ---------------------------------------------------------------- monolithic
     def monolithic(self, tol: float = 1e-10, max_iter: int = 60,
                    c: float | None = None) -> MortarSolution:
         """(Beyond the thesis) the discrete problem of :meth:`dtn` solved at once by a
-        semismooth Newton method (:func:`hpfebe.solvers.nonlinear.newton`, line search on
-        1/2 |F|^2).  Unknowns: the stamp's contact values u1 (condensed), the work
-        piece's free dofs u2 and the nodal contact forces y = (y_n, y_t) on body 1 in
-        the node frames (force on body 1 = -R^T y, on body 2 = +pi^T R^T y):
-
-            A1 u1 - b1 + R^T y = 0,   f_int(u2) - pi^T R^T y = 0 (free dofs),
-            y_n - max(0, y_n + c (d_n - g)) = 0,
-            y_t - clip(y_t + c d_t, -F w, F w) = 0,     d = R (u1 - pi u2|Gamma_C),
-
-        the KKT conditions of step 4 (projected CG + Uzawa) and the equilibrium of step
-        2 at a DtN fixed point.  c: the complementarity constant (default the mean
-        diagonal of A1).  Stop: ||F||_inf <= tol x force scale."""
-        nc, R, A1, b1 = self.nc, self.R, self.body1.A, self.body1.b
+        semismooth Newton method (:func:`hpfebe.solvers.newton`, line search on
+        1/2 |F|^2) on the KKT system :class:`MonolithicKKT`.  c: the complementarity
+        constant (default the mean diagonal of A1).  Stop: ||F||_inf <= tol x force
+        scale."""
         st2 = self.steps2
         st2.f_ext = np.zeros(self.work.ndofs)
         st2.problem(1.0)
-        free2 = st2.free
-        n1, nf = 2 * nc, free2.size
-        pos2 = -np.ones(self.work.ndofs, dtype=np.int64)
-        pos2[free2] = np.arange(nf)
-        # d = R u1 - R Pi u2[c2]: the columns of c2 among the free dofs of body 2
-        RPi = sp.csr_matrix(R @ self.Pi)
-        G2 = sp.csr_matrix((RPi.data, pos2[self.c2][RPi.indices], RPi.indptr),
-                           shape=(n1, nf))
-        Rs = sp.csr_matrix(R)
-        c = float(np.mean(np.diag(A1))) if c is None else float(c)
+        c = float(np.mean(np.diag(self.body1.A))) if c is None else float(c)
         _check_pos("c", c)
-        closed = np.isfinite(self.gap)
-        gap = np.where(closed, self.gap, 0.0)
-        bound = self.F * self.w
-        u2_full0 = self.elastic_start(st2.f_ext)
-        sl1, sl2, sly = slice(0, n1), slice(n1, n1 + nf), slice(n1 + nf, 2 * n1 + nf)
-
-        def split(z):
-            u2 = u2_full0.copy()
-            u2[free2] = z[sl2]
-            return z[sl1], u2, z[sly]
-
-        class Problem:
-            def evaluate(_, z):
-                u1, u2, y = split(z)
-                f2, T2 = self.work.internal_force(u2)
-                d = R @ u1 - G2 @ z[sl2]
-                zn = np.where(closed, y[:nc] + c * (d[:nc] - gap), -1.0)
-                zt = y[nc:] + c * d[nc:]
-                r = np.concatenate([A1 @ u1 - b1 + R.T @ y, f2[free2] - G2.T @ y,
-                                    y[:nc] - np.maximum(0.0, zn),
-                                    y[nc:] - np.clip(zt, -bound, bound)])
-                act, stick = zn > 0, np.abs(zt) < bound
-                scale = max(float(np.abs(f2).max(initial=0.0)), 1e-300)
-                return Iterate(z, r, 0.5 * float(r @ r), scale,
-                               key=(act.tobytes(), stick.tobytes()), data=(act, stick, T2))
-
-            def step(_, it):
-                act, stick, T2 = it.data
-                keep = np.concatenate([act, stick])      # rows -c dd; others dy
-                Kd = sp.diags(np.where(keep, -c, 0.0))
-                Ky = sp.diags(np.where(keep, 0.0, 1.0))
-                J = sp.bmat([[sp.csr_matrix(A1), None, Rs.T],
-                             [None, T2[free2][:, free2], -G2.T],
-                             [Kd @ Rs, -(Kd @ G2), Ky]], format="csc")
-                try:
-                    dz = spla.splu(J).solve(-it.residual)
-                except RuntimeError as e:
-                    raise SingularStep(f"singular Newton matrix: {e}") from None
-                if not np.all(np.isfinite(dz)):
-                    raise SingularStep("singular Newton matrix: non-finite step")
-                return dz
-
-            def slope(_, it, dz):
-                return -2.0 * it.merit
-
-        z0 = np.zeros(2 * n1 + nf)
-        z0[sl2] = u2_full0[free2]
-        it, info = newton(Problem(), z0, tol, max_iter, atol=tol * self.force_floor,
+        kkt = MonolithicKKT(self, c)
+        it, info = newton(kkt, kkt.start(), tol, max_iter, atol=tol * self.force_floor,
                           norm=np.inf)
-        u1c, u2, y = split(it.x)
-        info.counts = dict(c=c, unknowns=int(z0.size))
-        x = R @ u1c
+        u1c, u2, y = kkt.split(it.x)
+        info.counts = dict(c=c, unknowns=int(it.x.size))
+        nc, bound = self.nc, self.F * self.w
+        x = self.R @ u1c
         Q = self.Pi @ u2[self.c2]
         lam = np.divide(y[nc:], bound, out=np.zeros(nc), where=bound > 0)
-        P = -self.mortar.adjoint(R.T @ y)
+        P = -self.mortar.adjoint(self.R.T @ y)
         return MortarSolution(u1c, u2[self.c2], lam, Q, P, x, info,
                               extra=dict(u1=self.body1.expand(u1c), u2=u2, y=y,
                                          fields=self.work_fields(u2)))
@@ -620,25 +510,87 @@ class FEMortarContact(MortarContact):
         return out
 
 
-def section44_scene(stamp_cells=(10, 20), work_cells=(61, 31), E: float = 266926.0,
-                    nu: float = 0.29, sigma_Y: float = 4.0, H: float = 450.0,
-                    theta: float = 1.0, F: float = 0.22, lift: float = 1e-4,
-                    formulation: str = "bbar") -> FEMortarContact:
-    """The mortar scene of Section 4.4: Q1 stamp [-1/2, 1/2] x [0, 2] (``stamp_cells`` =
-    (nx, ny)), top fixed, on the J2 (sigma_Y, hardening H, isotropic share theta) Q1
-    work piece [-2, 2] x [-2, 0] (``work_cells``) whose bottom is displaced by
-    (0, ``lift``); plane strain, Tresca friction F on the stamp's bottom."""
-    from ..fem.elasticity import rectangle_mesh
-    from ..constitutive.j2 import J2Material
+# --------------------------------------------------------------------------- monolithic
+class MonolithicKKT:
+    """(Beyond the thesis) the discrete problem of :meth:`FEMortarContact.dtn` at once,
+    as a Newton problem (:class:`hpfebe.solvers.NewtonProblem`, semismooth).  Unknowns:
+    the stamp's contact values u1 (condensed), the work piece's free dofs u2 and the
+    nodal contact forces y = (y_n, y_t) on body 1 in the node frames (force on body 1 =
+    -R^T y, on body 2 = +pi^T R^T y):
 
-    for name, cells in (("stamp_cells", stamp_cells), ("work_cells", work_cells)):
-        if len(cells) != 2 or any(int(k) != k or k < 1 for k in cells):
-            raise ValueError(f"{name} must be two positive integers, got {cells!r}")
-    stamp = ElasticBody(rectangle_mesh(-0.5, 0.5, 0.0, 2.0, *map(int, stamp_cells)), E, nu)
-    work = ElastoPlasticFE(rectangle_mesh(-2.0, 2.0, -2.0, 0.0, *map(int, work_cells)),
-                           J2Material(E, nu, sigma_Y, H, theta), formulation)
-    return FEMortarContact(stamp, work, ("top", (0.0, 0.0)), ("bottom", (0.0, lift)), F)
+        A1 u1 - b1 + R^T y = 0,   f_int(u2) - pi^T R^T y = 0 (free dofs),
+        y_n - max(0, y_n + c (d_n - g)) = 0,
+        y_t - clip(y_t + c d_t, -F w, F w) = 0,     d = R (u1 - pi u2|Gamma_C),
+
+    the KKT conditions of step 4 (projected CG + Uzawa) and the equilibrium of step 2
+    at a DtN fixed point; c > 0 the complementarity constant.  The work piece's
+    prescribed values are those of ``pr.steps2`` (its load set to zero first)."""
+
+    def __init__(self, pr: "FEMortarContact", c: float):
+        nc, R, free2 = pr.nc, pr.R, pr.steps2.free
+        n1, nf = 2 * nc, free2.size
+        self.pr, self.c, self.nc, self.R, self.free2 = pr, c, nc, R, free2
+        self.A1, self.b1 = pr.body1.A, pr.body1.b
+        pos2 = -np.ones(pr.work.ndofs, dtype=np.int64)
+        pos2[free2] = np.arange(nf)
+        # d = R u1 - R Pi u2[c2]: the columns of c2 among the free dofs of body 2
+        RPi = sp.csr_matrix(R @ pr.Pi)
+        self.G2 = sp.csr_matrix((RPi.data, pos2[pr.c2][RPi.indices], RPi.indptr),
+                                shape=(n1, nf))
+        self.Rs = sp.csr_matrix(R)
+        self.closed = np.isfinite(pr.gap)
+        self.gap = np.where(self.closed, pr.gap, 0.0)
+        self.bound = pr.F * pr.w
+        self.u2_0 = pr.elastic_start(pr.steps2.f_ext)
+        self.sl = (slice(0, n1), slice(n1, n1 + nf), slice(n1 + nf, 2 * n1 + nf))
+
+    def start(self) -> np.ndarray:
+        """z_0: the stamp and the forces zero, the work piece's elastic response."""
+        z0 = np.zeros(self.sl[2].stop)
+        z0[self.sl[1]] = self.u2_0[self.free2]
+        return z0
+
+    def split(self, z):
+        """(u1, the work piece's full displacement u2, y) of the unknowns z."""
+        u2 = self.u2_0.copy()
+        u2[self.free2] = z[self.sl[1]]
+        return z[self.sl[0]], u2, z[self.sl[2]]
+
+    def evaluate(self, z) -> Iterate:
+        nc, c, bound = self.nc, self.c, self.bound
+        u1, u2, y = self.split(z)
+        f2, T2 = self.pr.work.internal_force(u2)
+        d = self.R @ u1 - self.G2 @ z[self.sl[1]]
+        zn = np.where(self.closed, y[:nc] + c * (d[:nc] - self.gap), -1.0)
+        zt = y[nc:] + c * d[nc:]
+        r = np.concatenate([self.A1 @ u1 - self.b1 + self.R.T @ y,
+                            f2[self.free2] - self.G2.T @ y,
+                            y[:nc] - np.maximum(0.0, zn),
+                            y[nc:] - np.clip(zt, -bound, bound)])
+        act, stick = zn > 0, np.abs(zt) < bound
+        scale = max(float(np.abs(f2).max(initial=0.0)), 1e-300)
+        return Iterate(z, r, 0.5 * float(r @ r), scale,
+                       key=(act.tobytes(), stick.tobytes()), data=(act, stick, T2))
+
+    def step(self, it: Iterate) -> np.ndarray:
+        act, stick, T2 = it.data
+        keep = np.concatenate([act, stick])      # rows -c dd; others dy
+        Kd = sp.diags(np.where(keep, -self.c, 0.0))
+        Ky = sp.diags(np.where(keep, 0.0, 1.0))
+        J = sp.bmat([[sp.csr_matrix(self.A1), None, self.Rs.T],
+                     [None, T2[self.free2][:, self.free2], -self.G2.T],
+                     [Kd @ self.Rs, -(Kd @ self.G2), Ky]], format="csc")
+        try:
+            dz = spla.splu(J).solve(-it.residual)
+        except RuntimeError as e:
+            raise SingularStep(f"singular Newton matrix: {e}") from None
+        if not np.all(np.isfinite(dz)):
+            raise SingularStep("singular Newton matrix: non-finite step")
+        return dz
+
+    def slope(self, it: Iterate, dz) -> float:
+        return -2.0 * it.merit
 
 
-__all__ = ["FEMortarContact", "READINGS", "fe_trace_mesh", "section44_scene",
+__all__ = ["FEMortarContact", "MonolithicKKT", "NeumannSettings", "fe_trace_mesh",
            "spd_band_solve"]

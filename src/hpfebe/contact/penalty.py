@@ -35,6 +35,7 @@ import numpy as np
 from ..solvers import SolverInfo
 from ..bodies.body import RigidObstacle, against_obstacle
 from ..constitutive.laws import positive
+from .settings import ContactSettings
 from .two_body import TwoBodyContact
 
 
@@ -96,8 +97,9 @@ def solve_penalty(bem, eps: float, gap, load=None, contact_label: str = "C",
     body, fixed, f = against_obstacle(bem, S, contact_label, dirichlet_label, load)
     pr = TwoBodyContact(body, RigidObstacle(gap), contact_label, eps_n=eps,
                         quadrature="exact")
-    res = pr.solve(f, fixed, rtol=tol, max_iter=max_iter, line_search=True, norm="max",
-                   merit="energy", roundoff_stop=True)
+    res = pr.solve(f, fixed, settings=ContactSettings(
+        rtol=tol, max_iter=max_iter, line_search=True, norm="max", merit="energy",
+        roundoff_stop=True))
     info = res.info.steps[-1]
     cs = pr.contact_state(res.U, 0.0)
     if info.converged and info.iterations == 0 and cs["n_active"] == 0:

@@ -94,7 +94,7 @@ Gauss points of the slave's contact elements, n_m = -n (n the slave's outward no
 t_m its tangent, g_n = g(x) - U_n, g_t = U_t - w(x): the one-body problems of Sections
 3.2-3.3 (:func:`hpfebe.contact.friction.solve_friction`).
 
-Algorithm 4.1 (:meth:`TwoBodyContact.solve` on :func:`hpfebe.solvers.nonlinear.load_path`): for
+Algorithm 4.1 (:meth:`TwoBodyContact.solve` on :func:`hpfebe.solvers.load_path`): for
 every load factor the load, the Dirichlet values and the obstacle motion are applied, the
 start iterate is the last converged state, semismooth Newton iterates (optionally with an
 Armijo line search on ||R||_2 or on the energy of a potential law; the semismooth
@@ -106,69 +106,22 @@ solved by LAPACK, sparse ones by a sparse LU with a check of its residual.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from typing import Optional, Sequence
 
 import numpy as np
 import scipy.linalg as sla
 import scipy.sparse as sp
 
-from ..solvers import Iterate, LineSearch, SolverInfo, load_path
-from ..quadrature import gauss_legendre
+from ..solvers import Iterate, SolverInfo, load_path
 from ..bodies.body import as_body, pointwise
-from ..constitutive.laws import OPEN, SLIP, STATE_NAMES, STICK  # noqa: F401  (re-exported)
 from ..constitutive.laws import penalty_friction, positive, tresca_energy
 from .loading import LoadSteps
+from .points import rigid_points, trace_maps, two_body_points
 from .positive_part import ExactPositivePart
+from .result import ContactResult
+from .settings import ContactSettings
 
 QUADRATURES = ("gauss", "exact")
-
-
-def project_onto_polyline(points: np.ndarray, a: np.ndarray, b: np.ndarray):
-    """Closest-point projection of ``points`` (n, 2) onto the segments a[k] -> b[k] (m, 2).
-
-    Returns (seg, s, excess, dist): the chosen segment per point, the clipped parameter
-    s in [0, 1] (x_m = a + s (b - a)), how far the unclipped parameter lies outside
-    [0, 1] (0 for an interior projection) and the distance.  Ties between equally near
-    segments (corners) go to the segment with the smallest excess."""
-    P = np.asarray(points, dtype=float)[:, None, :]
-    A, B = np.asarray(a, dtype=float)[None], np.asarray(b, dtype=float)[None]
-    d = B - A
-    L2 = np.sum(d * d, axis=2)
-    s_raw = np.sum((P - A) * d, axis=2) / L2
-    s = np.clip(s_raw, 0.0, 1.0)
-    excess = np.abs(s_raw - s)
-    dist = np.linalg.norm(P - (A + s[..., None] * d), axis=2)
-    scale = np.sqrt(L2.max())
-    dmin = dist.min(axis=1, keepdims=True)
-    near = dist <= dmin + 1e-10 * scale
-    key = np.where(near, excess, np.inf)
-    seg = np.argmin(key, axis=1)
-    i = np.arange(P.shape[0])
-    return seg, s[i, seg], excess[i, seg], dist[i, seg]
-
-
-
-
-def _trace_maps(nm, sides, ndofs):
-    """(G_n, G_t, t_m): the sparse maps U -> dg_n, dg_t at the points (one entry per
-    trace basis function, component and side) for the normals n_m, tangents
-    t_m = (n_m,y, -n_m,x); ``sides`` = [(body, ids, s, dof offset, sign)]."""
-    tm = np.column_stack([nm[:, 1], -nm[:, 0]])
-    n = nm.shape[0]
-    rows, cols, vn, vt = [], [], [], []
-    for body, ids, par, off, sign in sides:
-        tc, tv = body.trace(ids, par)
-        for j in range(tv.shape[1]):
-            for c in (0, 1):
-                rows.append(np.arange(n))
-                cols.append(tc[:, c, j] + off)
-                vn.append(sign * tv[:, j] * nm[:, c])
-                vt.append(sign * tv[:, j] * tm[:, c])
-    rows, cols = np.concatenate(rows), np.concatenate(cols)
-    Gn = sp.csr_matrix((np.concatenate(vn), (rows, cols)), shape=(n, ndofs))
-    Gt = sp.csr_matrix((np.concatenate(vt), (rows, cols)), shape=(n, ndofs))
-    return Gn, Gt, tm
 
 
 def _csr_block_diag(A: sp.csr_matrix, B: sp.csr_matrix) -> sp.csr_matrix:
@@ -205,90 +158,6 @@ def _force_lazy(body, u):
     the body can defer its tangent (``internal_force_lazy``, a plastic body)."""
     lazy = getattr(body, "internal_force_lazy", None)
     return lazy(u) if lazy is not None else body.internal_force(u)
-
-
-@dataclass
-class ContactResult:
-    """Outcome of :meth:`TwoBodyContact.solve` (and of :func:`solve_friction`).
-
-    U : the global dof vector (slave dofs first); u_slave, u_master : its two parts
-    converged, reason : overall outcome (the reason names the failed load step)
-    info : SolverInfo of the load path; ``steps`` its SolverInfo per attempted load step
-        (load_factor, iterations, residuals, converged, reason, state_counts)
-    Contact state at the slave contact points (last iterate): points (n, 2), weights
-    (quadrature weights, 0 for points outside the master), g_n (signed gap, < 0 is
-    penetration), g_t (relative tangential displacement), p_n >= 0, t_t, bound (slip
-    bound s), state (OPEN / STICK / SLIP), slip (g_t^p after the last converged step)
-    load_vector, obstacle_motion : load and obstacle motion w of the last step (to
-    continue loading with ``initial=``)
-    passes : the pass of each contact point (0: slave points on the master; 1, with
-    ``two_pass``: master points on the slave, whose ``elements`` are master facets);
-    ``weights * (passes == 0)`` integrates over the slave side only.  With two passes
-    ``total_forces`` sums both (the physical total force)
-    """
-
-    U: np.ndarray
-    u_slave: np.ndarray
-    u_master: np.ndarray
-    converged: bool
-    reason: str
-    info: SolverInfo
-    points: np.ndarray
-    weights: np.ndarray
-    g_n: np.ndarray
-    g_t: np.ndarray
-    p_n: np.ndarray
-    t_t: np.ndarray
-    bound: np.ndarray
-    state: np.ndarray
-    slip: np.ndarray
-    elements: np.ndarray = None
-    load_vector: np.ndarray = None
-    obstacle_motion: np.ndarray = None
-    friction: str = "coulomb"
-    passes: np.ndarray = None
-
-    @property
-    def steps(self) -> list:
-        return self.info.steps
-
-    @property
-    def iterations(self) -> list:
-        return [s.iterations for s in self.steps]
-
-    @property
-    def residuals(self) -> list:
-        return [s.residuals for s in self.steps]
-
-    residual_histories = residuals
-
-    @property
-    def state_names(self) -> list:
-        return [STATE_NAMES[int(k)] for k in self.state]
-
-    @property
-    def stick(self) -> np.ndarray:
-        return self.state == STICK
-
-    @property
-    def slipping(self) -> np.ndarray:
-        return self.state == SLIP
-
-    @property
-    def gap_function(self) -> np.ndarray:
-        """U_n - g = -g_n (> 0: penetration)."""
-        return -self.g_n
-
-    @property
-    def rel_slip(self) -> np.ndarray:
-        return self.g_t
-
-    def total_forces(self) -> tuple[float, float]:
-        """(int p_n ds, int t_t ds) over Gamma_C."""
-        return float(self.weights @ self.p_n), float(self.weights @ self.t_t)
-
-
-TwoBodyResult = ContactResult
 
 
 class TwoBodyContact:
@@ -341,12 +210,13 @@ class TwoBodyContact:
         # (4.27) / (4.33): FE blocks sparse, a BE block (dense S_hat) inside; a system
         # without FE body (BE against rigid or BE) stays dense
         self.dense = "FE" not in (sb.kind, mb.kind)
-        if mb.kind == "rigid":
-            self._build_rigid(slave_boundary)
-            self.passes = np.zeros(len(self.points), dtype=np.intp)
-        else:
-            self._build_contact(slave_boundary, master_boundary)
-            self.motion = np.zeros(len(self.points))
+        # the contact points and their per-point arrays (:mod:`.points`)
+        pts = rigid_points(sb, mb, slave_boundary, self.nq, self.ndofs) \
+            if mb.kind == "rigid" else \
+            two_body_points(sb, mb, slave_boundary, master_boundary, self.offset,
+                            self.ndofs, self.nq, self.split, self.two_pass)
+        for key, value in pts.items():
+            setattr(self, key, value)
         self.F = None if F is None else pointwise("F", F, self.points, allow_negative=False)
         self.law_name = "tresca" if F is not None else "coulomb"
         self.exact = self._exact_quadrature(quadrature, slave_boundary)
@@ -383,121 +253,6 @@ class TwoBodyContact:
         if self.dense:
             return sla.block_diag(*[b.S for b in (sb, mb) if b.kind == "BE"])
         return sp.block_diag([sb.K, mb.K], format="csr")
-
-    # ------------------------------------------------------------------ geometry
-    def _build_rigid(self, slave_boundary) -> None:
-        """Contact points of one body against a rigid obstacle: Gauss points on every
-        slave contact segment; the obstacle's normal is -n (n the body's outward
-        normal), its tangent the body's t, g_n = g(x) - U_n."""
-        S, obstacle = self.bodies["slave"], self.bodies["master"]
-        seg = S.segments(slave_boundary)
-        ids = seg["ids"]
-        if ids.size == 0:
-            raise ValueError(f"slave_boundary {slave_boundary!r}: no element carries this label")
-        deg = np.full(ids.size, S.degree) if S.kind == "FE" else S.mesh.degrees[ids]
-        pf, ps, pw = [], [], []
-        for m in np.unique(deg if self.nq is None else [self.nq]):
-            sel = np.flatnonzero(deg == m) if self.nq is None else np.arange(ids.size)
-            t, w = gauss_legendre(int(m) + 1 if self.nq is None else int(m))
-            pf.append(np.repeat(sel, t.size))
-            ps.append(np.tile(0.5 * (1.0 + np.asarray(t)), sel.size))
-            pw.append(np.tile(0.5 * np.asarray(w), sel.size))
-        order = np.argsort(np.concatenate(pf), kind="stable")
-        pf, ps, pw = (np.concatenate(v)[order] for v in (pf, ps, pw))
-        a, b = seg["a"][pf], seg["b"][pf]
-        self.points = a + ps[:, None] * (b - a)
-        self.weights = pw * np.linalg.norm(b - a, axis=1)
-        self.point_facets = ids[pf]
-        self.outside = np.zeros(pf.size, bool)
-        nm = -seg["normals"][pf]
-        self._set_traces(nm, [(S, ids[pf], ps, 0, 1.0)])
-        self.g0 = pointwise("gap", obstacle.gap, self.points)
-        self.motion = pointwise("obstacle_slip", obstacle.motion, self.points)
-
-    def _set_traces(self, nm, sides) -> None:
-        """Normals n_m, tangents t_m and the sparse maps U -> dg_n, dg_t at the points."""
-        self.normals = nm
-        self.Gn, self.Gt, self.tangents = _trace_maps(nm, sides, self.ndofs)
-
-    def _build_contact(self, slave_boundary, master_boundary) -> None:
-        """Contact points of two deformable bodies: pass 0 (points on the slave's contact
-        segments, projected onto the master polyline, master normals); with ``two_pass``
-        also pass 1 (the roles swapped: points on the master's segments, slave normals).
-        Every per-point array is the concatenation of the passes (pass 0 first);
-        ``self.passes`` says which pass a point belongs to."""
-        S, M = self.bodies["slave"], self.bodies["master"]
-        slave = (S, S.segments(slave_boundary), 0)
-        master = (M, M.segments(master_boundary), self.offset)
-        parts = [self._contact_pass(slave, master)]
-        if self.two_pass:
-            parts.append(self._contact_pass(master, slave))
-        for key in ("points", "weights", "outside", "master_points", "point_facets", "g0",
-                    "normals", "tangents"):
-            setattr(self, key, np.concatenate([q[key] for q in parts]))
-        for key in ("Gn", "Gt"):
-            setattr(self, key, parts[0][key] if len(parts) == 1
-                    else sp.vstack([q[key] for q in parts], format="csr"))
-        self.passes = np.concatenate([np.full(q["points"].shape[0], k, dtype=np.intp)
-                                      for k, q in enumerate(parts)])
-
-    def _contact_pass(self, point_side, target_side) -> dict:
-        """One master-slave pass (Section 4.2, the gap (4.18)): ``point_side`` = (body,
-        its contact segments, dof offset) carries the contact points, ``target_side`` the
-        polyline they are projected onto and whose outward normals n_T give the gap
-        g_n = (x_P + u_P - x_T - u_T) . n_T and slip g_t = (u_P - u_T) . t_T (traces with
-        sign +1 for the point body, -1 for the target).  Pass 0: (slave, master); pass 1
-        of ``two_pass``: (master, slave).  Returns the per-point arrays (points, weights,
-        outside, master_points = the projections x_T, point_facets = the point body's
-        facet/element ids, g0, normals, tangents, Gn, Gt)."""
-        P, psg, poff = point_side
-        T, tsg, toff = target_side
-        fs, xa, xb = psg["ids"], psg["a"], psg["b"]
-        A, B, ma, mb = tsg["a"], tsg["b"], tsg["va"], tsg["vb"]
-        # integration segments: every point segment is split where a target vertex
-        # projects onto it, so that both traces are polynomial on each piece (a BE trace
-        # of degree p needs p + 1 Gauss points per piece)
-        mpts = np.vstack([A, B])
-        mseg, ms, mexc, _ = project_onto_polyline(mpts, xa, xb)
-        inner = (mexc == 0) & (ms > 1e-12) & (ms < 1 - 1e-12)
-        if not self.split:
-            inner[:] = False
-        nq = 2 if self.nq is None else self.nq
-        if P.kind == "BE" or T.kind == "BE":
-            nq = max(nq, max(P.degree, T.degree) + 1)
-        t, w = gauss_legendre(nq)
-        t, w = np.asarray(t, dtype=float), np.asarray(w, dtype=float)
-        pf, ps, pw = [], [], []
-        for i in range(fs.size):
-            br = np.unique(np.concatenate([[0.0, 1.0], ms[inner & (mseg == i)]]))
-            # drop breakpoints closer than rounding (a target vertex seen from two segments)
-            br = br[np.concatenate([[True], np.diff(br) > 1e-12])]
-            br[-1] = 1.0
-            lo, hi = br[:-1], br[1:]
-            sp_ = (lo[:, None] + 0.5 * (1 + t)[None, :] * (hi - lo)[:, None]).ravel()
-            pf.append(np.full(sp_.size, i))
-            ps.append(sp_)
-            pw.append((0.5 * (hi - lo)[:, None] * w[None, :]).ravel())
-        pf, ps, pw = np.concatenate(pf), np.concatenate(ps), np.concatenate(pw)
-        length = np.linalg.norm(xb - xa, axis=1)
-        pts = xa[pf] + ps[:, None] * (xb[pf] - xa[pf])
-        wts = pw * length[pf]
-        # target segments
-        seg, s, excess, _ = project_onto_polyline(pts, A, B)
-        seg_len = np.linalg.norm(B - A, axis=1)
-        # outside: clipped onto an end vertex of the target polyline (a vertex of one
-        # target segment only); clipped onto an inner corner vertex is a valid contact
-        _, inv = np.unique(np.concatenate([ma, mb]), return_inverse=True)
-        counts = np.bincount(inv)
-        vid = np.where(s < 0.5, inv[seg], inv[ma.size + seg])
-        outside = (excess * seg_len[seg] > 1e-10 * seg_len.max()) & (counts[vid] == 1)
-        xm = A[seg] + s[:, None] * (B[seg] - A[seg])
-        nm = tsg["normals"][seg]
-        Gn, Gt, tm = _trace_maps(nm, [(P, fs[pf], ps, poff, 1.0),
-                                      (T, tsg["ids"][seg], s, toff, -1.0)], self.ndofs)
-        return dict(points=pts, weights=np.where(outside, 0.0, wts), outside=outside,
-                    master_points=xm, point_facets=fs[pf],
-                    g0=np.sum((pts - xm) * nm, axis=1), normals=nm, tangents=tm,
-                    Gn=Gn, Gt=Gt)
 
     # ------------------------------------------------------------------ dof helpers
     def global_dofs(self, body: str, dofs: np.ndarray) -> np.ndarray:
@@ -565,7 +320,7 @@ class TwoBodyContact:
         q = self.exact.points(U)
         S, ids = self.bodies["slave"], q["ids"]
         nm = -S.mesh.normals[ids]
-        Gn, Gt, _ = _trace_maps(nm, [(S, ids, q["s"], 0, 1.0)], self.ndofs) if ids.size \
+        Gn, Gt, _ = trace_maps(nm, [(S, ids, q["s"], 0, 1.0)], self.ndofs) if ids.size \
             else (sp.csr_matrix((0, self.ndofs)),) * 2 + (None,)
         return dict(Gn=Gn, Gt=Gt, weights=q["weights"], g0=q["g0"],
                     points=S.mesh.points(ids, 2.0 * q["s"] - 1.0) if ids.size
@@ -658,72 +413,33 @@ class TwoBodyContact:
 
     # ------------------------------------------------------------------ Algorithm 4.1
     def solve(self, f_ext=None, fixed_dofs=None, fixed_values=None,
-              load_factors: Sequence[float] = (1.0,), rtol: float = 1e-10,
-              atol: float = 0.0, max_iter: int = 30, line_search: bool = False,
-              min_step: float = 2.0 ** -12, max_cuts: int = 0, norm: str = "l2",
-              merit: str = "residual", predictor: bool = False,
-              roundoff_stop: bool = False,
-              initial: ContactResult | None = None,
-              lu_ordering: str = "COLAMD", linear_solver: str = "lu") -> ContactResult:
+              load_factors: Sequence[float] = (1.0,),
+              settings: ContactSettings = ContactSettings(),
+              initial: ContactResult | None = None) -> ContactResult:
         """Incremental loading with semismooth Newton (Algorithm 4.1,
-        :func:`hpfebe.solvers.nonlinear.load_path`).
+        :func:`hpfebe.solvers.load_path`) with the Newton, line-search, cut and
+        linear-solver settings ``settings`` (:class:`ContactSettings`).
 
         ``f_ext`` global load at load factor 1 (scaled by lambda) or a callable
         lambda -> vector; ``fixed_dofs`` with ``fixed_values`` (at lambda = 1, scaled;
         a callable; None = 0); the obstacle motion is ramped like the load;
         ``load_factors`` increasing; a failed step is halved and retried from the last
-        converged state at most ``max_cuts`` times.  Newton stops when
-        ||R_free|| <= atol + rtol * scale, ``norm`` "l2" or "max", scale = the largest
-        of the load, the body force and the contact force of the iterate (max-norm over
-        the free dofs; not relative to R^(0), which grows like 1/eps and would accept
-        wrong contact sets for stiff penalties);
-        ``roundoff_stop``: a Newton update at round-off level ends the step, converged
-        only if the backward error is small (:func:`hpfebe.solvers.nonlinear.newton`).  ``line_search``: Armijo on
-        ``merit`` ("residual": ||R||_2, down to ``min_step``; "energy": the potential,
-        for frictionless and Tresca contact, 30 halvings); cycling of the contact
-        state is then detected.  ``predictor``: start each step from the bonded
-        solution (every point in contact and sticking) when it lowers the merit.
-        ``initial``: a converged result of this problem to continue from (U, slip,
-        load and obstacle motion ramped from its final values).  ``lu_ordering``: the
-        column ordering of the sparse LU of a system with an FE body
-        (:data:`hpfebe.contact.loading.LU_ORDERINGS`: "COLAMD", SuperLU's default, or
-        "MMD_AT_PLUS_A", faster, other round-off).  ``linear_solver``
-        (:data:`hpfebe.contact.loading.LINEAR_SOLVERS`): "lu", a sparse LU of every
-        Newton matrix, or for linear bodies with an FE body "woodbury", one
-        factorisation of the bodies' stiffness for the whole load path and the contact
-        terms by the Sherman-Morrison-Woodbury formula on the active points
-        (:class:`hpfebe.contact.loading.WoodburySolver`: the same Newton steps up to
-        round-off; measured 7x less CPU on 83,076 dofs with 640 contact points)."""
-        steps = LoadSteps(self, f_ext, fixed_dofs, fixed_values, merit, initial,
-                          lu_ordering, linear_solver)
+        converged state at most ``settings.max_cuts`` times.  ``initial``: a converged
+        result of this problem to continue from (U, slip, load and obstacle motion
+        ramped from its final values)."""
+        if not isinstance(settings, ContactSettings):
+            raise ValueError(f"settings must be a ContactSettings, got {settings!r}")
+        steps = LoadSteps(self, f_ext, fixed_dofs, fixed_values, settings, initial)
         lf = np.asarray(load_factors, dtype=float).ravel()
         if lf.size == 0 or not np.all(np.isfinite(lf)):
-            raise ValueError(f"load_factors must be a non-empty finite sequence, got {load_factors!r}")
-        tol = positive("rtol", rtol, allow_zero=True)
-        atol = positive("atol", atol, allow_zero=True)
-        if tol == 0 and atol == 0:
-            raise ValueError("rtol and atol must not both be zero")
-        if isinstance(max_iter, bool) or int(max_iter) != max_iter or max_iter < 1:
-            raise ValueError(f"max_iter must be a positive integer, got {max_iter!r}")
-        min_step = float(min_step)
-        if not (np.isfinite(min_step) and 0 < min_step <= 1):
-            raise ValueError(f"min_step must lie in (0, 1], got {min_step!r}")
-        if norm not in ("l2", "max"):
-            raise ValueError(f"norm must be 'l2' or 'max', got {norm!r}")
-        if merit == "energy":
-            ls = LineSearch(enabled=line_search)
-        else:
-            ls = LineSearch(slack=0.0, max_halvings=int(round(-np.log2(min_step))),
-                            accept_last=True, enabled=line_search)
-        steps.detect_cycling = line_search
-        it, info = load_path(steps, lf, steps.x0, max_cuts=max_cuts, lam0=0.0, tol=tol,
-                             atol=atol, max_iter=int(max_iter), line_search=ls,
-                             norm=np.inf if norm == "max" else 2,
-                             predictor=steps.bonded_predictor if predictor else None,
-                             roundoff_stop=roundoff_stop)
-        return self._result(it, info, steps)
+            raise ValueError(f"load_factors must be a non-empty finite sequence, got "
+                             f"{load_factors!r}")
+        it, info = load_path(steps, lf, steps.x0, max_cuts=settings.max_cuts, lam0=0.0,
+                             **steps.newton_options())
+        return self.result(it, info, steps)
 
-    def _result(self, it: Iterate, info: SolverInfo, steps) -> ContactResult:
+    def result(self, it: Iterate, info: SolverInfo, steps: LoadSteps) -> ContactResult:
+        """The :class:`ContactResult` of the iterate ``it`` of the load ``steps``."""
         U, cs = it.x, it.data
         return ContactResult(
             U=U.copy(), u_slave=U[: self.offset].copy(), u_master=U[self.offset:].copy(),

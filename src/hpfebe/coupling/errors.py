@@ -22,26 +22,20 @@ sides of the corner, so the trace is smooth).  ``be_trace_energy_error`` gives t
 of the energy norm of Theorem 2.2.3, |u - U2|_W on Gamma2, as the mesh-independent
 companion.
 
-``lambda_sweep`` builds the system of one mesh pair once, solves it for several
-lambda_Nit (only the penalty blocks are rescaled) and measures all of the above: the
-rows of the Chapter 2 tables and figures.
+:func:`hpfebe.scenes.interface.lambda_sweep` builds the system of one mesh pair once,
+solves it for several lambda_Nit (only the penalty blocks are rescaled) and measures all
+of the above: the rows of the Chapter 2 tables and figures.
 """
 
 from __future__ import annotations
 
-import logging
-import time
 
 import numpy as np
 from scipy.spatial import cKDTree
 
 from ..analysis.norms import energy_error_dirichlet
 from ..quadrature import gauss_legendre, gauss_lobatto
-from .examples import InterfaceProblem, problem as get_problem
-from .nitsche import DEFAULT_ALPHA, DEFAULT_H_DEF, NitscheFEBE, NitscheSolution
-
-log = logging.getLogger(__name__)
-
+from .nitsche import NitscheFEBE, NitscheSolution
 
 def fe_errors(model: NitscheFEBE, sol: NitscheSolution) -> dict:
     """{'l2', 'h1'}: L2 and H1-seminorm errors of U1 in Omega1."""
@@ -239,47 +233,3 @@ def be_trace_energy_error(model: NitscheFEBE, sol: NitscheSolution, extra: int =
     u = model.problem.u
     return energy_error_dirichlet(model.bem, sol.U2, lambda x, n: u(x[:, 0], x[:, 1]),
                                   extra=extra)
-
-
-def lambda_sweep(problem: InterfaceProblem | str, fe_h_inv: float, be_h_inv: float, p: int,
-                 lambdas, alpha: float = DEFAULT_ALPHA, h_def: str = DEFAULT_H_DEF,
-                 companions: bool = False) -> list[dict]:
-    """One row per lambda_Nit in ``lambdas`` for the mesh pair (fe_h_inv, be_h_inv) and
-    p1 = p2 = p; the system is assembled once.  Row keys: lambda_nit, p, fe_h_inv,
-    be_h_inv, n_fe, n_be, dof, fe_l2, fe_h1, be_l2, be_h1 (``fe_errors``,
-    ``be_domain_errors``), assembly_s, solve_s, wall_time_s (assembly + solve),
-    residual (relative, of the linear solve); ``companions`` adds be_energy
-    (``be_trace_energy_error``, which assembles a richer W per solve) and be_h1_interp
-    (``be_domain_errors(interpolate_exact=True)``)."""
-    pb = get_problem(problem) if isinstance(problem, str) else problem
-    lambdas = [float(v) for v in np.atleast_1d(lambdas)]
-    if not lambdas:
-        raise ValueError("lambdas must name at least one lambda_Nit")
-    t0 = time.perf_counter()
-    model = NitscheFEBE(pb, fe_h_inv, be_h_inv, int(p), alpha=alpha, h_def=h_def)
-    t_asm = time.perf_counter() - t0
-    rows = []
-    setup = None                    # BE-part error geometry, shared by the lambda_Nit
-    for lambda_nit in lambdas:
-        t1 = time.perf_counter()
-        sol = model.solve(lambda_nit)
-        t_solve = time.perf_counter() - t1
-        fe = fe_errors(model, sol)
-        setup = setup or BEDomainSetup(model)
-        if companions:
-            be, be_exact = be_domain_errors_both(model, sol, setup=setup)
-        else:
-            be = setup.errors(model, sol, ("solution",))["solution"]
-        row = dict(lambda_nit=lambda_nit, p=int(p), fe_h_inv=fe_h_inv, be_h_inv=be_h_inv,
-                   n_fe=model.n1, n_be=model.n2, dof=model.ndof, fe_l2=fe["l2"],
-                   fe_h1=fe["h1"], be_l2=be["l2"], be_h1=be["h1"], assembly_s=t_asm,
-                   solve_s=t_solve, wall_time_s=t_asm + t_solve,
-                   residual=sol.info["residual"])
-        if companions:
-            row["be_energy"] = be_trace_energy_error(model, sol)
-            row["be_h1_interp"] = be_exact["h1"]
-        rows.append(row)
-        log.info("%s p=%d FE 1/%g BE 1/%g lambda_Nit=%g dof=%d: FE %.3e %.3e BE %.3e %.3e "
-                 "(%.2f s + %.2f s)", pb.name, p, fe_h_inv, be_h_inv, lambda_nit,
-                 model.ndof, fe["l2"], fe["h1"], be["l2"], be["h1"], t_asm, t_solve)
-    return rows

@@ -45,16 +45,18 @@ from __future__ import annotations
 import logging
 import time
 from dataclasses import dataclass, field
+from typing import Callable
 
 import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
 from ..bem import LaplaceBEM
+from ..fem.meshes import FEDomain, tensor_block_mesh
 from ..fem.poisson import PoissonFE
+from ..geometry import BoundaryMesh
 from ..quadrature import gauss_legendre
 from ..solvers import SolverInfo
-from .examples import InterfaceProblem
 from .interface import interface_rule
 
 log = logging.getLogger(__name__)
@@ -64,11 +66,61 @@ DEFAULT_LAMBDA = 10.0
 DEFAULT_H_DEF = "edge"
 
 
+@dataclass(frozen=True)
+class InterfaceProblem:
+    """An FE/BE interface problem (2.2) with known solution (the thesis's two:
+    :mod:`hpfebe.scenes.interface`).
+
+    Meshes: the FE mesh of size 1/h_inv is the per-block tensor grid of
+    :func:`~hpfebe.fem.meshes.tensor_block_mesh` on the blocks ``xbreaks`` x ``ybreaks``
+    inside ``in_omega1``; the BE mesh of size 1/h_inv puts ``ceil(|side| h_inv)`` equal
+    elements on each side of the polygon dOmega2 (``be_vertices``, labels ``be_labels``:
+    "D" on Gamma_D, "I" on the interface).  FE boundary facets are labelled by
+    ``fe_label``: "D", "I" (on dOmega2) or "N".
+
+    ``u(x, y)``, ``grad_u(x, y) -> (ux, uy)`` and ``f(x, y)`` (None: f = 0) are vectorised.
+    ``singular_points``: where grad u is unbounded (error integrals are graded there).
+    """
+
+    name: str
+    u: Callable
+    grad_u: Callable
+    f: Callable | None
+    xbreaks: tuple
+    ybreaks: tuple
+    in_omega1: Callable
+    in_omega2: Callable
+    fe_label: Callable
+    be_vertices: tuple
+    be_labels: tuple
+    singular_points: tuple = ()
+
+    def fe_domain(self, h_inv: float) -> FEDomain:
+        """FE mesh of Omega1 with cells of size <= 1/h_inv (class doc)."""
+        return tensor_block_mesh(self.xbreaks, self.ybreaks, h_inv, self.in_omega1,
+                                 self.fe_label)
+
+    def omega2_domain(self, h_inv: float) -> FEDomain:
+        """Rectangle mesh of Omega2 of size 1/h_inv (for the BE-part domain errors)."""
+        v = np.asarray(self.be_vertices, dtype=float)
+        return tensor_block_mesh(np.unique(v[:, 0]), np.unique(v[:, 1]), h_inv,
+                                 self.in_omega2, lambda x, y: np.full(np.shape(x), "B"))
+
+    def be_mesh(self, h_inv: float, p: int) -> BoundaryMesh:
+        """Boundary mesh of dOmega2 with elements of size <= 1/h_inv and degree p."""
+        if not (np.isfinite(h_inv) and h_inv > 0):
+            raise ValueError(f"h_inv must be positive, got {h_inv!r}")
+        v = np.asarray(self.be_vertices, dtype=float)
+        sides = np.linalg.norm(np.roll(v, -1, axis=0) - v, axis=1)
+        n = [max(1, int(np.ceil(L * h_inv - 1e-9))) for L in sides]
+        return BoundaryMesh.polygon(v, n=n, labels=list(self.be_labels), p=p)
+
+
 @dataclass
 class NitscheSolution:
     """Solution of (2.3): U1 (FE, all dofs of ``fe``), U2 (BE, all dofs of ``V_space``),
     and diagnostics (``info``: residual, timings, sizes; ``solver``: the
-    :class:`hpfebe.solvers.nonlinear.SolverInfo` of the direct solve, residuals relative to the
+    :class:`hpfebe.solvers.SolverInfo` of the direct solve, residuals relative to the
     right-hand side)."""
 
     lambda_nit: float

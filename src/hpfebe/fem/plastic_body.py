@@ -24,8 +24,8 @@ it only after a load step converged); a failed, cut load step therefore restarts
 committed state automatically.  :class:`PlasticFEBody` wraps the body as a contact
 :class:`~hpfebe.bodies.body.FEBody` (kind "FE", segments, traces, dofs ...).
 
-:class:`DisplacementSteps` is the :class:`hpfebe.solvers.nonlinear.LoadStep` of a body alone under
-prescribed displacements and loads (no contact), for :func:`hpfebe.solvers.nonlinear.load_path`.
+:class:`DisplacementSteps` is the :class:`hpfebe.solvers.LoadStep` of a body alone under
+prescribed displacements and loads (no contact), for :func:`hpfebe.solvers.load_path`.
 """
 
 from __future__ import annotations
@@ -294,7 +294,7 @@ class ElastoPlasticFE:
 
 
 class DisplacementSteps:
-    """Load steps of one body alone (:class:`hpfebe.solvers.nonlinear.LoadStep`): at load factor
+    """Load steps of one body alone (:class:`hpfebe.solvers.LoadStep`): at load factor
     lam the dofs ``fixed`` are prescribed to lam * ``values`` and the external load is
     lam * ``f_ext``; residual R = f_int(u) - lam f_ext on the free dofs, merit 1/2 |R|^2,
     force scale max |f_int| (reactions included); each step starts from the secant

@@ -8,14 +8,16 @@ semismooth Newton with the algorithmic tangents (4.36)-(4.43) of the plastic bod
 
 One *touch* (:func:`touch`): stamp top fixed, work piece bottom u_y = g (u_x = 0) with g
 raised from 0 to ``u_total`` in ``n_load`` equal increments and lowered back to 0 in
-``n_unload`` increments.  Every increment is one :meth:`TwoBodyContact.solve` continued
-from the last converged state (``initial``) with the prescribed values ramped from the
-last to the new ones (a cut increment is halved between them); Newton starts from the
-secant extrapolation of the last two converged states, at the first unloading increment
-from the rigidly lowered work piece (the plastic body's force is a pure function of the
-displacement and its committed history, so the start only changes the iteration count:
-measured 3-6 Newton iterations per loading increment after the first instead of 15-20
-from the last state).  The plastic history is committed after each converged increment.
+``n_unload`` increments.  The increments are one load path of Algorithm 4.1
+(:func:`hpfebe.solvers.load_path` on the load steps of :class:`TouchSteps`): load factor
+lambda in (k - 1, k] is increment k, the prescribed values ramped from the last to the
+new ones (a cut increment is halved between them, at most ``max_cuts`` times per
+increment); Newton starts from the secant extrapolation of the last two converged
+increments, at the first unloading increment from the rigidly lowered work piece (the
+plastic body's force is a pure function of the displacement and its committed history,
+so the start only changes the iteration count: measured 3-6 Newton iterations per
+loading increment after the first instead of 15-20 from the last state).  The slip and
+the plastic history are committed after each converged step.
 
 A second touch (Example 1) starts from the state left by the first: the work piece keeps
 its committed history and carries the residual displacement of the first touch as an
@@ -31,6 +33,7 @@ from __future__ import annotations
 
 import dataclasses
 from dataclasses import dataclass, field
+from typing import Callable
 
 import numpy as np
 
@@ -41,45 +44,49 @@ from ..fem.plastic_body import ElastoPlasticFE
 from ..constitutive.j2 import J2Material
 from ..bodies import BEBody, PlasticBEBody, PlasticFEBody
 from ..bodies.plastic_be import rectangle_work_piece
-from ..contact.loading import LU_ORDERINGS
+from ..contact.loading import LoadSteps
+from ..contact.settings import ContactSettings
 from ..contact.two_body import TwoBodyContact
+from ..solvers import Iterate, SolverInfo, load_path
 
 SIDES = ("bottom", "right", "top", "left")
 STAMP_KINDS = ("FE", "BE")
 
 
+#: the solver of the touches: Newton to rtol = 1e-8 of the force scale, at most 40
+#: iterations, Armijo line search on ||R||, at most 4 cuts per increment, and the bonded
+#: predictor of :class:`TwoBodyContact` (taken when it lowers the merit; measured: the
+#: first increment of the second touch of Example 1 at h = 0.1 needs 33 iterations with
+#: it, 98 in 3 attempts without).  ``lu_ordering`` "MMD_AT_PLUS_A" is ~1.7x faster per
+#: factorisation than SuperLU's default "COLAMD", with other round-off: measured, the
+#: iteration counts of the unloading increments and the load path of a hard increment
+#: (a step cut or not) change, and with them the results of those runs by up to
+#: 1e-4 .. 3e-2 relative.
+STAMP_SOLVER = ContactSettings(rtol=1e-8, max_iter=40, max_cuts=4, line_search=True,
+                               predictor=True)
+
+
 @dataclass(frozen=True)
-class ContactSettings:
-    """Penalty and solver data: 1/eps_n = eps_n_factor E, 1/eps_t = eps_t_factor E,
-    Coulomb mu_f; Newton tolerance rtol (relative to the force scale), max_iter, at most
-    max_cuts halvings per increment; ``predictor``: TwoBodyContact's bonded predictor
-    (taken when it lowers the merit; measured: the first increment of the second touch
-    of Example 1 at h = 0.1 needs 33 iterations with it, 98 in 3 attempts without).
-    ``F``: a given (Tresca) friction bound, |t_t| <= F on all of Gamma_C (the penalty
-    law (4.20) with the slip bound F in place of mu_f |p_n|); None = Coulomb with mu_f,
-    a given F replaces mu_f (:meth:`friction`).  ``lu_ordering``: the column ordering of
-    the sparse LU of the Newton systems (:data:`hpfebe.contact.loading.LU_ORDERINGS`;
-    "MMD_AT_PLUS_A" is ~1.7x faster per factorisation than SuperLU's default "COLAMD",
-    with other round-off: measured, the iteration counts of the unloading increments
-    and the load path of a hard increment (a step cut or not) change, and with them
-    the results of those runs by up to 1e-4 .. 3e-2 relative).  ``two_pass``: the
-    symmetric two-pass penalty contact of :class:`TwoBodyContact` (a second pass with
-    the stamp and the work piece swapped; contact stiffness about 2/eps_n on a flat
-    interface, the single pass at eps/2 there); False = the thesis's single pass."""
+class StampContact:
+    """The penalty contact of a stamping scene: 1/eps_n = eps_n_factor E, 1/eps_t =
+    eps_t_factor E, Coulomb mu_f; ``F``: a given (Tresca) friction bound, |t_t| <= F on
+    all of Gamma_C (the penalty law (4.20) with the slip bound F in place of mu_f |p_n|);
+    None = Coulomb with mu_f, a given F replaces mu_f (:meth:`friction`).  ``two_pass``:
+    the symmetric two-pass penalty contact of :class:`TwoBodyContact` (a second pass
+    with the stamp and the work piece swapped; contact stiffness about 2/eps_n on a flat
+    interface, the single pass at eps/2 there); False = the thesis's single pass.
+    ``solver``: the :class:`ContactSettings` of the touches (:data:`STAMP_SOLVER`; a
+    touch adds its absolute floor ``atol``, ``max_cuts`` counts per increment)."""
 
     eps_n_factor: float = 10.0
     eps_t_factor: float = 5.0
     mu_f: float = 0.2
-    rtol: float = 1e-8
-    max_iter: int = 40
-    max_cuts: int = 4
-    predictor: bool = True
     F: float | None = None
-    lu_ordering: str = "COLAMD"
     two_pass: bool = False
+    solver: ContactSettings = STAMP_SOLVER
 
     def __post_init__(self):
-        for name in ("eps_n_factor", "eps_t_factor", "rtol"):
+        for name in ("eps_n_factor", "eps_t_factor"):
             if not getattr(self, name) > 0:
                 raise ValueError(f"{name} must be positive, got {getattr(self, name)!r}")
         if self.mu_f < 0:
@@ -89,14 +96,10 @@ class ContactSettings:
                 or self.F < 0):
             raise ValueError(f"F (Tresca bound) must be None or a finite number >= 0, got "
                              f"{self.F!r}")
-        if self.lu_ordering not in LU_ORDERINGS:
-            raise ValueError(f"lu_ordering must be one of {LU_ORDERINGS}, got "
-                             f"{self.lu_ordering!r}")
         if not isinstance(self.two_pass, (bool, np.bool_)):
             raise ValueError(f"two_pass must be a bool, got {self.two_pass!r}")
-        if self.max_iter < 1 or self.max_cuts < 0:
-            raise ValueError(f"max_iter must be >= 1 and max_cuts >= 0, got "
-                             f"{self.max_iter!r}, {self.max_cuts!r}")
+        if not isinstance(self.solver, ContactSettings):
+            raise ValueError(f"solver must be a ContactSettings, got {self.solver!r}")
 
     def friction(self) -> dict:
         """The friction keywords of :class:`TwoBodyContact`: Coulomb ``mu_f`` (F None)
@@ -181,7 +184,7 @@ def lift_schedule(u_total: float, n_load: int, n_unload: int) -> np.ndarray:
     return np.concatenate([up, down])
 
 
-def _stamp_on_work(stamp, body, E: float, settings: ContactSettings):
+def _stamp_on_work(stamp, body, E: float, settings: StampContact):
     """The penalty contact of the stamp's bottom (slave) on the work piece's top
     (master), 1/eps = factor x E, and the dofs a touch prescribes: the stamp's top and
     the work piece's bottom (``is_y`` marks the lifted y components)."""
@@ -192,8 +195,114 @@ def _stamp_on_work(stamp, body, E: float, settings: ContactSettings):
     return (pr, *pr.stamp_dofs())
 
 
+class TouchSteps:
+    """The load steps of one touch (:class:`hpfebe.solvers.LoadStep`) on the load steps
+    of the contact problem (:class:`hpfebe.contact.loading.LoadSteps`): load factor
+    lambda in (k - 1, k] is increment k of the lift schedule ``lifts`` (g_0 = 0), the
+    prescribed lift ramped linearly from g_{k-1} to g_k on the dofs ``is_y``; the start of
+    an increment is :meth:`extrapolated`; after each converged increment
+    ``on_increment(k, result)`` is called with the :class:`ContactResult` of its last
+    step (its ``info`` the increment's attempts)."""
+
+    def __init__(self, pr: TwoBodyContact, fixed, is_y, lifts, work_y,
+                 solver: ContactSettings, on_increment: Callable):
+        self.contact = LoadSteps(pr, None, fixed, self.lift, solver)
+        self.is_y, self.lifts, self.work_y = is_y, np.asarray(lifts, dtype=float), work_y
+        self.on_increment = on_increment
+        self.hist = []                 # (g, U) of the converged increments
+        self.attempts = []             # SolverInfo of the current increment's attempts
+        self.lam, self.lam_done = 0.0, 0.0
+
+    @staticmethod
+    def increment(lam: float) -> int:
+        """The (0-based) increment of load factor lam in (k, k + 1]."""
+        return int(np.ceil(lam)) - 1
+
+    def lift(self, lam: float) -> np.ndarray:
+        """The prescribed values at load factor lam: g_{k-1} + (lam - k) (g_k - g_{k-1})
+        on the lifted dofs, 0 on the others."""
+        k = self.increment(lam)
+        a, b = (self.lifts[k - 1] if k else 0.0), self.lifts[k]
+        return np.where(self.is_y, a + (lam - k) * (b - a), 0.0)
+
+    def extrapolated(self, x: np.ndarray, g: float) -> np.ndarray:
+        """The Newton start of an increment to the lift g: the secant extrapolation of
+        the last two converged increments (x before the first).  At a reversal of the
+        lift (unloading) the extrapolation points the wrong way; there the start is U1
+        with the work piece's y dofs ``work_y`` translated by g - g1 and the stamp at
+        rest: the plastic work piece springs back by O(sigma_Y / E) x height only, far
+        less than the lift, so the contact opens."""
+        if not self.hist:
+            return x
+        if len(self.hist) == 1:
+            (g1, U1), (g0, U0) = self.hist[-1], (0.0, np.zeros_like(x))
+        else:
+            (g1, U1), (g0, U0) = self.hist[-1], self.hist[-2]
+        if (g - g1) * (g1 - g0) > 0:
+            return U1 + (g - g1) / (g1 - g0) * (U1 - U0)
+        U = U1.copy()
+        U[self.work_y] += g - g1
+        U[:self.contact.pr.offset] = 0.0
+        return U
+
+    # LoadStep protocol
+    def problem(self, lam: float):
+        self.lam = lam
+        return self.contact.problem(lam)
+
+    def start(self, x: np.ndarray, lam: float) -> np.ndarray:
+        k = self.increment(lam)
+        if self.lam_done == k:         # the first step of increment k (or its cut)
+            x = self.extrapolated(x, self.lifts[k])
+        return self.contact.start(x, lam)
+
+    def record(self, it: Iterate, info: SolverInfo) -> None:
+        self.contact.record(it, info)
+        self.attempts.append(info)
+
+    def commit(self, it: Iterate) -> None:
+        self.contact.commit(it)
+        self.lam_done = self.lam
+        k = self.increment(self.lam)
+        if self.lam == k + 1:          # increment k converged
+            self.hist.append((self.lifts[k], it.x.copy()))
+            info = SolverInfo(True, "converged", steps=self.attempts,
+                              iterations=sum(a.iterations for a in self.attempts))
+            self.attempts = []
+            # the LU cache of the contact steps holds one increment's factorisations
+            self.contact.forget_factorisations()
+            self.on_increment(k, self.contact.pr.result(it, info, self.contact))
+
+
+def _touch_path(pr, fixed, is_y, work_y, lifts, settings: StampContact, atol: float,
+                on_increment, touch_id: int) -> TouchResult:
+    """All increments of one touch (lifts ``lifts``) as one load path; ``atol`` the
+    absolute floor of the stopping test.  A failed increment (after ``max_cuts`` cuts)
+    ends the touch with its reason."""
+    solver = dataclasses.replace(settings.solver, atol=atol)
+    steps = TouchSteps(pr, fixed, is_y, lifts, work_y, solver, on_increment)
+    _, info = load_path(steps, np.arange(1.0, len(lifts) + 1), steps.contact.x0,
+                        max_cuts=solver.max_cuts, cuts_per_step=True,
+                        **steps.contact.newton_options())
+    out = TouchResult()
+    if not info.converged:
+        k = TouchSteps.increment(info.steps[-1].load_factor)
+        out.converged = False
+        out.reason = (f"touch {touch_id}, increment {k + 1} (g = {lifts[k]:.3e}): "
+                      f"{info.reason}")
+    return out
+
+
+def _absolute_floor(settings: StampContact, material: J2Material, width: float) -> float:
+    """The absolute floor of the stopping test: rtol x sigma_Y x width, the force scale
+    of the plastic work piece (when the stamp is lifted off, the forces at equilibrium
+    shrink to residual stresses and the relative test alone asks for more digits);
+    sigma_Y capped at 1e-3 E (J2Material.stress_floor)."""
+    return settings.solver.rtol * material.stress_floor * width
+
+
 def touch(stamp, fe: ElastoPlasticFE, u_total: float, n_load: int, n_unload: int,
-          X, settings: ContactSettings, offset=None, touch_id: int = 1) -> TouchResult:
+          X, settings: StampContact, offset=None, touch_id: int = 1) -> TouchResult:
     """One touch (module doc): returns the per-increment records, the snapshot at the
     peak and the work piece's total displacement at the end (the offset of a next
     touch).  A failed increment (after ``max_cuts`` cuts) ends the touch with its reason;
@@ -202,63 +311,27 @@ def touch(stamp, fe: ElastoPlasticFE, u_total: float, n_load: int, n_unload: int
     pr, fixed, is_y = _stamp_on_work(stamp, body, fe.material.E, settings)
     bottom_y = fe.elastic.dofs_on("bottom", 1)
     work_y = pr.global_dofs("master", fe.elastic.nodal_dofs[1])
-    # absolute floor of the stopping test: rtol x sigma_Y x width, the force scale of
-    # the plastic work piece (when the stamp is lifted off, the forces at equilibrium
-    # shrink to residual stresses and the relative test alone asks for more digits);
-    # sigma_Y capped at 1e-3 E (J2Material.stress_floor)
-    width = float(np.ptp(fe.mesh.p[0]))
-    atol = settings.rtol * fe.material.stress_floor * width
-    out = TouchResult()
-    res, hist = None, []                       # hist: (g, U) of converged increments
-    g_prev = 0.0
-    sched = lift_schedule(u_total, n_load, n_unload)
-    for k, g in enumerate(sched):
-        def values(lam, a=g_prev, b=g):
-            return np.where(is_y, a + lam * (b - a), 0.0)
-        init = _extrapolated(res, hist, g, work_y)
-        new = pr.solve(None, fixed, values, load_factors=[1.0], rtol=settings.rtol,
-                       max_iter=settings.max_iter, max_cuts=settings.max_cuts,
-                       atol=atol, line_search=True, predictor=settings.predictor,
-                       initial=init, lu_ordering=settings.lu_ordering)
-        if not new.converged:
-            out.converged = False
-            out.reason = f"touch {touch_id}, increment {k + 1} (g = {g:.3e}): {new.reason}"
-            break
-        res = new
-        hist.append((g, res.U.copy()))
-        g_prev = g
-        out.records.append(StepRecord(
-            touch_id, "load" if k < n_load else "unload", float(g),
+    lifts = lift_schedule(u_total, n_load, n_unload)
+    records, last = [], {}
+
+    def on_increment(k: int, res) -> None:
+        last["res"] = res
+        records.append(StepRecord(
+            touch_id, "load" if k < n_load else "unload", float(lifts[k]),
             float(fe.committed_force()[bottom_y].sum()),
             fe.value_at("dev_sigma_norm", X), fe.value_at("eps_p_norm", X),
             int(res.info.iterations), len(res.info.steps)))
         if k == n_load - 1:
-            out.peak = Snapshot(touch_id, stamp, res.u_slave.copy(),
-                                body.offset + res.u_master, _mean_fields(fe), res)
-    if res is not None:
-        out.u_work = body.offset + res.u_master
+            last["peak"] = Snapshot(touch_id, stamp, res.u_slave.copy(),
+                                    body.offset + res.u_master, _mean_fields(fe), res)
+
+    atol = _absolute_floor(settings, fe.material, float(np.ptp(fe.mesh.p[0])))
+    out = _touch_path(pr, fixed, is_y, work_y, lifts, settings, atol, on_increment,
+                      touch_id)
+    out.records, out.peak = records, last.get("peak")
+    if "res" in last:
+        out.u_work = body.offset + last["res"].u_master
     return out
-
-
-def _extrapolated(res, hist, g, shift):
-    """The Newton start of the next increment: the last converged result with U
-    replaced by the secant extrapolation to the prescribed value g (None before the
-    first increment).  At a reversal of the lift (unloading) the extrapolation points the
-    wrong way; there the start is U1 with the work piece's y dofs ``shift`` translated
-    by g - g1 and the stamp at rest: the plastic work piece springs back by
-    O(sigma_Y / E) x height only, far less than the lift, so the contact opens."""
-    if res is None:
-        return None
-    if len(hist) == 1:
-        (g1, U1), (g0, U0) = hist[-1], (0.0, np.zeros_like(res.U))
-    else:
-        (g1, U1), (g0, U0) = hist[-1], hist[-2]
-    if (g - g1) * (g1 - g0) > 0:
-        return dataclasses.replace(res, U=U1 + (g - g1) / (g1 - g0) * (U1 - U0))
-    U = U1.copy()
-    U[shift] += g - g1
-    U[:res.u_slave.size] = 0.0
-    return dataclasses.replace(res, U=U)
 
 
 def _mean_fields(fe: ElastoPlasticFE) -> dict:
@@ -355,7 +428,7 @@ def be_work_piece(box, h: float, material: J2Material, cells: str = "crossed"):
                                 scheme="implicit", cells=cells)
 
 
-def touch_be(stamp, be, u_total: float, n_load: int, X, settings: ContactSettings,
+def touch_be(stamp, be, u_total: float, n_load: int, X, settings: StampContact,
              touch_id: int = 1) -> TouchResult:
     """One loading touch (no unloading) of the stamp on the elastoplastic BE work piece
     ``be`` (:class:`hpfebe.bodies.plastic_be.ElastoPlasticBE`, contact body
@@ -368,30 +441,22 @@ def touch_be(stamp, be, u_total: float, n_load: int, X, settings: ContactSetting
     pr, fixed, is_y = _stamp_on_work(stamp, body, be.material.E, settings)
     by_local = body.dofs_on("bottom", 1)
     work_y = pr.global_dofs("master", np.arange(1, be.ndofs, 2))
-    width = float(np.ptp(be.bem.mesh.nodes[:, 0]))
-    atol = settings.rtol * be.material.stress_floor * width
-    out = TouchResult()
-    res, hist, g_prev = None, [], 0.0
-    for k, g in enumerate(lift_schedule(u_total, n_load, 0)):
-        def values(lam, a=g_prev, b=g):
-            return np.where(is_y, a + lam * (b - a), 0.0)
-        new = pr.solve(None, fixed, values, load_factors=[1.0], rtol=settings.rtol,
-                       max_iter=settings.max_iter, max_cuts=settings.max_cuts,
-                       atol=atol, line_search=True, predictor=settings.predictor,
-                       initial=_extrapolated(res, hist, g, work_y),
-                       lu_ordering=settings.lu_ordering)
-        if not new.converged:
-            out.converged = False
-            out.reason = f"touch {touch_id}, increment {k + 1} (g = {g:.3e}): {new.reason}"
-            break
-        res, g_prev = new, g
-        hist.append((g, res.U.copy()))
-        u = res.u_master
-        force = float((be.S @ u - be.plastic_force())[by_local].sum())
-        out.records.append(StepRecord(
-            touch_id, "load", float(g), force, be.value_at("dev_sigma_norm", X),
+    lifts = lift_schedule(u_total, n_load, 0)
+    records, last = [], {}
+
+    def on_increment(k: int, res) -> None:
+        last["res"] = res
+        force = float((be.S @ res.u_master - be.plastic_force())[by_local].sum())
+        records.append(StepRecord(
+            touch_id, "load", float(lifts[k]), force, be.value_at("dev_sigma_norm", X),
             be.value_at("eps_p_norm", X), int(res.info.iterations), len(res.info.steps)))
-    if res is not None:
+
+    atol = _absolute_floor(settings, be.material, float(np.ptp(be.bem.mesh.nodes[:, 0])))
+    out = _touch_path(pr, fixed, is_y, work_y, lifts, settings, atol, on_increment,
+                      touch_id)
+    out.records = records
+    if "res" in last:
+        res = last["res"]
         out.u_work = res.u_master.copy()
         f = {k: v.copy() for k, v in be.fields().items()}
         f["node_u"] = be.node_displacements(out.u_work)

@@ -20,6 +20,8 @@ import dataclasses
 import types
 import typing
 
+__all__ = ["from_config", "ConfigError"]
+
 
 class ConfigError(ValueError):
     """A config value of the wrong type or an unknown key.

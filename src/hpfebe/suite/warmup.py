@@ -44,7 +44,7 @@ def _bem(steps: dict) -> None:
     steps["laplace"] = time.perf_counter() - t
 
     t = time.perf_counter()
-    lame = LameBEM(mesh, 1.0, 0.3)   # p = 1: the closed forms (lowest_order.lame_p1)
+    lame = LameBEM(mesh, 1.0, 0.3)   # p = 1: the closed forms (lowest_order_lame.lame_p1)
     lame.S_hat                       # (its threaded row chunks: the same types)
     steps["lame"] = time.perf_counter() - t
 
@@ -70,7 +70,8 @@ def _bem(steps: dict) -> None:
 
 
 def _contact(steps: dict) -> None:
-    from ..contact.mortar import model_problem, projected_cg
+    from ..scenes.mortar import model_problem
+    from ..solvers import UzawaSettings, projected_cg
 
     t = time.perf_counter()
     A = np.array([[2.0, -1.0], [-1.0, 2.0]])
@@ -79,7 +80,7 @@ def _contact(steps: dict) -> None:
 
     t = time.perf_counter()
     mc = model_problem(n1=2, n2=2, p1=1, p2=1)
-    mc.uzawa(np.zeros(2 * len(mc.points)), max_iter=2)
+    mc.uzawa(np.zeros(2 * len(mc.points)), UzawaSettings(max_iter=2, relative=False))
     steps["uzawa"] = time.perf_counter() - t
 
 

@@ -1,0 +1,64 @@
+"""The one load path (Algorithm 4.1, :func:`load_path`): Newton for each load factor of an
+increasing sequence; a problem's history (e.g. the slip of a friction law, the plastic
+state of a body) is updated by ``commit(x)`` only after a converged step, and a failed
+step is halved and retried from the committed state (at most ``max_cuts`` times)."""
+
+from __future__ import annotations
+
+from typing import Protocol
+
+import numpy as np
+
+from .info import Iterate, NewtonProblem, SolverInfo
+from .newton import newton
+
+
+class LoadStep(Protocol):
+    """One load factor of a load path: a Newton problem, its start and its commit."""
+
+    def problem(self, lam: float) -> NewtonProblem: ...
+
+    def start(self, x: np.ndarray, lam: float) -> np.ndarray: ...
+
+    def commit(self, it: Iterate) -> None: ...
+
+    def record(self, it: Iterate, info: SolverInfo) -> None: ...
+
+
+def load_path(steps: LoadStep, factors, x0: np.ndarray, max_cuts: int = 0,
+              lam0: float = 0.0, cuts_per_step: bool = False, **newton_kw):
+    """Algorithm 4.1: Newton for every load factor of the increasing sequence
+    ``factors``, the history committed after each converged step; a failed step is cut
+    in half and retried from the committed state, at most ``max_cuts`` times in all
+    (``cuts_per_step``: at most ``max_cuts`` times between two factors of ``factors``).
+    Returns (last iterate, SolverInfo with one SolverInfo per attempted step in
+    ``steps``)."""
+    queue = [float(f) for f in factors]
+    given = set(queue)              # the factors asked for (the others are cuts)
+    x, last = np.asarray(x0, dtype=float), None
+    total = SolverInfo(True, "converged")
+    cuts = 0
+    lam_done = lam0
+    while queue:
+        lam = queue[0]
+        it, info = newton(steps.problem(lam), steps.start(x, lam), **newton_kw)
+        info.load_factor = lam
+        steps.record(it, info)
+        total.steps.append(info)
+        total.iterations += info.iterations
+        last = it
+        if info.converged:
+            steps.commit(it)
+            x, lam_done = it.x, lam
+            queue.pop(0)
+            if cuts_per_step and lam in given:
+                cuts = 0
+        elif cuts < max_cuts:
+            cuts += 1
+            queue.insert(0, 0.5 * (lam_done + lam))
+        else:
+            total.converged = False
+            n = len(total.steps)
+            total.reason = f"load step {n}/{n + len(queue) - 1}: {info.reason}"
+            break
+    return last, total

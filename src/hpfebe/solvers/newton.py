@@ -1,0 +1,126 @@
+"""Semismooth Newton with an Armijo line search on a merit function (:func:`newton`):
+round-off, cycling and divergence detection, an optional predictor; the problem is a
+:class:`~hpfebe.solvers.info.NewtonProblem` (residual, step, slope), the result a
+:class:`~hpfebe.solvers.info.SolverInfo`."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Callable
+
+import numpy as np
+
+from .info import EPS, Iterate, NewtonProblem, SingularStep, SolverInfo, residual_norm, \
+    roundoff_verdict
+
+
+@dataclass
+class LineSearch:
+    """Armijo backtracking: accept alpha in 1, 1/2, 1/4, ... with
+    merit(x + alpha dx) <= merit(x) + c alpha slope + slack |merit(x)|; after
+    ``max_halvings`` halvings either fail ("line search failed") or, with
+    ``accept_last``, take the last trial step.  ``enabled=False``: always the full
+    step."""
+
+    c: float = 1e-4
+    slack: float = 1e-14
+    max_halvings: int = 30
+    accept_last: bool = False
+    enabled: bool = True
+
+
+def _line_search(problem, it: Iterate, dx: np.ndarray, ls: LineSearch):
+    """(alpha, new iterate) or (alpha, None) if the search failed."""
+    if not ls.enabled:
+        return 1.0, problem.evaluate(it.x + dx)
+    slope = problem.slope(it, dx)
+    alpha = 1.0
+    for k in range(ls.max_halvings + 1):
+        trial = problem.evaluate(it.x + alpha * dx)
+        ok = np.isfinite(trial.merit) and \
+            trial.merit <= it.merit + ls.c * alpha * slope + ls.slack * abs(it.merit)
+        if ok or (ls.accept_last and k == ls.max_halvings):
+            return alpha, trial
+        alpha *= 0.5
+    return alpha, None
+
+
+def newton(problem: NewtonProblem, x0: np.ndarray, tol: float, max_iter: int = 50,
+           atol: float = 0.0, norm=np.inf, line_search: LineSearch | None = None,
+           predictor: Callable[[Iterate], np.ndarray | None] | None = None,
+           roundoff_stop: bool = False, divergence: float = 1e12):
+    """Semismooth Newton from x0.  Returns (final iterate, SolverInfo).
+
+    ``predictor``: an optional first candidate (e.g. a linear "bonded" solution), taken
+    when its merit is lower; it counts as an iteration.  ``roundoff_stop``: a Newton
+    update at round-off level relative to x ends the iteration as converged (for
+    ill-conditioned systems whose residual floor lies above tol) - as converged only if
+    the backward error ||R|| / scale is below BACKWARD_TOL = 1e-6, else
+    "ill-conditioned".  Cycling: a contact
+    pattern (``Iterate.key``) met before without decrease of the merit since then ends
+    the iteration ("cycling"), or as converged if the step was at round-off level
+    (stagnation).  Divergence: a non-finite residual, or one above ``divergence`` times
+    the initial residual and force scale."""
+    ls = line_search or LineSearch()
+    it = problem.evaluate(np.asarray(x0, dtype=float))
+    res = [residual_norm(it.residual, norm)]
+    info = SolverInfo(False, "max_iter", 0, res, [], [it.merit])
+
+    def done(i: Iterate) -> bool:
+        return residual_norm(i.residual, norm) <= atol + tol * i.scale
+
+    if done(it):
+        info.converged, info.reason = True, "converged"
+        return it, info
+    if predictor is not None:
+        cand = predictor(it)
+        if cand is not None:
+            pit = problem.evaluate(cand)
+            if np.all(np.isfinite(pit.residual)) and pit.merit < it.merit:
+                it, info.predictor_used, info.iterations = pit, True, 1
+                res.append(residual_norm(it.residual, norm))
+                info.merits.append(it.merit)
+                if done(it):
+                    info.converged, info.reason = True, "converged"
+                    return it, info
+    seen = {}
+    for k in range(info.iterations + 1, int(max_iter) + 1):
+        try:
+            dx = problem.step(it)
+        except SingularStep as e:
+            info.reason = str(e)
+            return it, info
+        xmax = np.abs(it.x).max(initial=0.0)
+        if roundoff_stop and np.abs(dx).max(initial=0.0) <= 64 * EPS * xmax:
+            # the k-th Newton system was solved (and counts), its update is not taken;
+            # converged only if the backward error of the iterate is small
+            info.iterations = k
+            roundoff_verdict(info, it, norm, "Newton update at round-off level")
+            return it, info
+        alpha, new = _line_search(problem, it, dx, ls)
+        if new is None:
+            info.reason = "line search failed"
+            return it, info
+        it = new
+        info.iterations = k
+        info.step_lengths.append(alpha)
+        r = residual_norm(it.residual, norm)
+        res.append(r)
+        info.merits.append(it.merit)
+        if not np.isfinite(r) or r > divergence * max(res[0], it.scale):
+            info.reason = f"diverged: residual {r:.3e} at iteration {k}"
+            return it, info
+        if done(it):
+            info.converged, info.reason = True, "converged"
+            return it, info
+        if it.key is not None:
+            if it.key in seen and it.merit >= seen[it.key][1] - 1e-14 * abs(it.merit):
+                if alpha * np.abs(dx).max() <= 1e-8 * np.abs(it.x).max():
+                    roundoff_verdict(info, it, norm, "stagnation at round-off level")
+                else:
+                    info.reason = (f"cycling: contact state of iterate {seen[it.key][0]} "
+                                   f"repeated at {k} without decrease of the merit")
+                return it, info
+            seen[it.key] = (k, it.merit)
+    info.reason = "max_iter"
+    return it, info
