@@ -34,7 +34,6 @@ from __future__ import annotations
 import dataclasses
 import logging
 import math
-import time
 from dataclasses import dataclass
 
 import numpy as np
@@ -48,7 +47,8 @@ from hpfebe.fem import (cell_diameter, is_conforming, local_mesh_size, new_verti
                         refine_labelled, refinement_concentration)
 from hpfebe.io import fe_vtu
 from hpfebe.scenes import adaptive_fefe as scene
-from hpfebe.suite import ArtefactResult, Claim, beats_uniform_claim, from_config, progress
+from hpfebe.suite import (ArtefactResult, Claim, beats_uniform_claim, from_config, new_figure,
+                          progress, slope_line, style_axes, timed)
 
 ARTEFACTS = ("figure_4_13", "figure_4_14", "figure_4_15", "figure_4_16")
 NUMBA = False    # FE/FE only: runs beside the job that compiles the numba kernels
@@ -138,6 +138,9 @@ class Params(scene.FEFEContactScene):
         if not 0 < self.theta <= 1 or not 0 <= self.concentration_share <= 1:
             raise ValueError(f"theta must lie in (0, 1] and concentration_share in [0, 1], "
                              f"got {self.theta!r}, {self.concentration_share!r}")
+        if any(k < 0 for k in self.mesh_steps):
+            raise ValueError(f"mesh_steps must be refinement steps >= 0, got "
+                             f"{self.mesh_steps!r}")
         if self.linear_solver not in LINEAR_SOLVERS:
             raise ValueError(f"linear_solver must be one of {LINEAR_SOLVERS}, got "
                              f"{self.linear_solver!r}")
@@ -319,29 +322,24 @@ def _plot_meshes(meshes, steps):
 
 
 def _plot_decay(ad, un, body, fig_no):
-    fig = Figure(figsize=(6, 4.5))
-    ax = fig.add_subplot(111)
+    fig, ax = new_figure((6, 4.5))
     dcol, ecol = f"dof_{body}", f"eta_{body}"
     ax.loglog(un[dcol], un[ecol], "s-", label="uniform")
     ax.loglog(ad[dcol], ad[ecol], "o-", ms=3, label="adaptive")
     d0, e0 = float(un[dcol].iloc[0]), float(un[ecol].iloc[0])
     dd = np.array([d0, max(float(un[dcol].max()), float(ad[dcol].max()))])
     for s, ls in ((-0.5, "k--"), (-0.25, "k:")):
-        ax.loglog(dd, e0 * (dd / d0) ** s, ls, lw=0.8, label=f"DOF^{s}")
-    ax.set_xlabel(f"DOF ({body})")
-    ax.set_ylabel("indicator (3.100)")
+        slope_line(ax, dd, s, (d0, e0), ls, lw=0.8, label=f"DOF^{s}")
     name = "\\Omega_s" if body == "slave" else "\\Omega_m"
-    ax.set_title(f"Figure {fig_no}: error indicator in ${name}$")
-    ax.legend()
-    ax.grid(True, which="both", alpha=0.3)
+    style_axes(ax, f"DOF ({body})", "indicator (3.100)",
+               f"Figure {fig_no}: error indicator in ${name}$", legend={})
     fig.tight_layout()
     return fig
 
 
 def _plot_displacement(pr, res):
-    fig = Figure(figsize=(11, 5))
-    for j, comp in enumerate(("x", "y")):
-        ax = fig.add_subplot(1, 2, j + 1)
+    fig, axes = new_figure((11, 5), 1, 2)
+    for j, (ax, comp) in enumerate(zip(axes, ("x", "y"))):
         vals = [b.nodal_displacement(u)[j] for b, u in
                 ((pr.slave, res.u_slave), (pr.master, res.u_master))]
         lo = min(v.min() for v in vals)
@@ -468,19 +466,16 @@ def figure_4_16(prm, hist, exports, notes, meta) -> ArtefactResult:
 def run(config: dict, quick: bool = False) -> list[ArtefactResult]:
     """Figures 4.13-4.16 (``quick`` is unused: config/quick.yaml sets the sizes)."""
     prm = from_config(Params, config, scene="ch4_adaptive_fefe")
-    t0 = time.perf_counter()
-    ad, ad_hist = refinement_run(prm, "adaptive", prm.n_refinements)
-    t1 = time.perf_counter()
+    (ad, ad_hist), adaptive_s = timed(refinement_run, prm, "adaptive", prm.n_refinements)
     target = (int(ad["dof_slave"].iloc[-1]), int(ad["dof_master"].iloc[-1]))
-    un, un_hist = refinement_run(
-        prm, "uniform", prm.max_uniform_steps,
+    (un, un_hist), uniform_s = timed(
+        refinement_run, prm, "uniform", prm.max_uniform_steps,
         stop=lambda rec: (rec["step"] >= prm.min_uniform_steps and
                           all(d > t for d, t in zip(rec["ndof"], target))))
-    t2 = time.perf_counter()
     exports = {**vtu_meshes("adaptive_final", *ad_hist.state, ad_hist.eta),
                **vtu_meshes("uniform_final", *un_hist.state, un_hist.eta)}
     notes = common_notes(prm, ad, un)
-    meta = dict(run_s=t2 - t0, adaptive_s=t1 - t0, uniform_s=t2 - t1,
+    meta = dict(run_s=adaptive_s + uniform_s, adaptive_s=adaptive_s, uniform_s=uniform_s,
                 n_refinements=prm.n_refinements,
                 newton_all_converged=bool(ad["newton_converged"].all() and
                                           un["newton_converged"].all()),

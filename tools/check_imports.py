@@ -1,5 +1,6 @@
 #!/usr/bin/env python
-"""Import layering of src/hpfebe: no cycle between its subpackages and top-level modules.
+"""Import layering of src/hpfebe: no cycle between its subpackages and top-level modules,
+and every import goes down the layers of DESIGN.md.
 
 Every import statement of every module is read (``ast``; module level and inside
 functions alike, absolute and relative) and mapped to the *unit* it reaches: the
@@ -9,7 +10,12 @@ the unit ``x`` when ``x`` is a subpackage or module, the root otherwise.  Import
 one unit are not edges.  A strongly connected set of units (Tarjan) is a cycle; each is
 printed with one shortest cycle through it and the file:line of every edge on it.
 
-    python tools/check_imports.py                 # exit 1 if any cycle, else 0
+The layers (:data:`LAYERS`, bottom first, as DESIGN.md lists them): a unit may import only
+units of lower layers.  An import up the list (``solvers`` importing ``contact``) is a
+layering violation, printed with its file:line; a unit missing from :data:`LAYERS` is an
+error (a new subpackage gets its place in DESIGN.md and here).
+
+    python tools/check_imports.py                 # exit 1 if any cycle or violation
     python tools/check_imports.py --graph         # also print every edge
     python tools/check_imports.py --experiments   # deep imports in experiments/
 
@@ -28,6 +34,12 @@ from collections import defaultdict, deque
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
+
+#: the layers of DESIGN.md ("The core, as data flows through it"), bottom first; the root
+#: ``hpfebe`` (its lazy curated API reaches every layer) sits on top with the CLI
+LAYERS = (("checks",), ("geometry", "quadrature"), ("spaces",), ("constitutive",), ("solvers",), ("bem",),
+          ("fem",), ("analysis",), ("bodies",), ("coupling",), ("contact",), ("adaptivity",),
+          ("io",), ("scenes",), ("suite",), ("cli", "__main__", "hpfebe"))
 PKG = ROOT / "src" / "hpfebe"
 PKG_NAME = "hpfebe"
 
@@ -252,6 +264,27 @@ def check_experiments(strict: bool = False) -> int:
     return 1 if (strict and deep) else 0
 
 
+def layer_violations() -> list[str]:
+    """Each unit edge that goes up the layers (or reaches a unit with no layer), with the
+    file:line of its imports."""
+    rank = {u: i for i, layer in enumerate(LAYERS) for u in layer}
+    out = [f"unit {u!r} has no layer: add it to LAYERS (tools/check_imports.py) and "
+           f"to DESIGN.md" for u in sorted(top_units() | {PKG_NAME}) if u not in rank]
+    for (a, b), where in sorted(edges().items()):
+        if a in rank and b in rank and rank[b] > rank[a]:
+            out.append(f"{a} (layer {rank[a]}) imports {b} (layer {rank[b]}): "
+                       f"{', '.join(where)}")
+    return out
+
+
+def check_layers() -> int:
+    bad = layer_violations()
+    for line in bad:
+        print(line)
+    print(f"{len(bad)} layering violations ({len(LAYERS)} layers)")
+    return len(bad)
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--graph", action="store_true", help="print every unit edge")
@@ -261,7 +294,8 @@ def main(argv=None) -> int:
     args = ap.parse_args(argv)
     if args.experiments:
         return check_experiments(args.strict)
-    return 1 if check_cycles(args.graph) else 0
+    cycles = check_cycles(args.graph)
+    return 1 if (cycles or check_layers()) else 0
 
 
 if __name__ == "__main__":

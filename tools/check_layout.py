@@ -3,6 +3,7 @@
 
     python tools/check_layout.py            # print every figure; exit 1 if one fails
     python tools/check_layout.py --list     # also list every offender
+    python tools/check_layout.py --open "experiments/ lines"   # a known open figure
 
 Limits checked:
 
@@ -10,7 +11,8 @@ Limits checked:
   except numba kernels (functions decorated with ``njit``/``jit``/``vectorize``; they are
   counted and named apart);
 * experiments/: under 4000 lines in all, no file over 500 lines;
-* no import cycle between the units of hpfebe (``tools/check_imports.py``);
+* no import cycle between the units of hpfebe and no import up the layers of DESIGN.md
+  (``tools/check_imports.py``);
 * experiments import only public names (``check_imports.py --experiments --strict``);
 * the curated API: ``hpfebe.__all__`` has about 25 names (20-40 accepted).
 
@@ -72,6 +74,9 @@ def rel(path: Path) -> str:
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--list", action="store_true", help="list every offender")
+    ap.add_argument("--open", action="append", default=[], metavar="WORDS",
+                    help="a figure known to be over its limit (matched by words of its "
+                         "name): printed as OPEN, not a failure; repeatable")
     args = ap.parse_args(argv)
     rows = []            # (figure, value, limit, ok, offenders)
 
@@ -100,6 +105,8 @@ def main(argv=None) -> int:
 
     cycles = check_imports.check_cycles(quiet=True)
     rows.append(("import cycles between hpfebe units", cycles, 0, cycles == 0, []))
+    up = check_imports.layer_violations()
+    rows.append(("imports up the layers of DESIGN.md", len(up), 0, not up, up))
     deep = check_imports.deep_imports()
     rows.append(("experiments' imports of non-public names", len(deep), 0, not deep, deep))
 
@@ -109,17 +116,20 @@ def main(argv=None) -> int:
     rows.append(("names in hpfebe.__all__ (about 25)", n_api, "20-40", 20 <= n_api <= 40, []))
 
     width = max(len(r[0]) for r in rows)
-    failed = 0
+    failed = n_open = 0
     for figure, value, limit, ok, offenders in rows:
-        mark = "ok  " if ok else "FAIL"
-        failed += not ok
+        known = not ok and any(w in figure for w in args.open)
+        mark = "ok  " if ok else ("OPEN" if known else "FAIL")
+        failed += not ok and not known
+        n_open += known
         lim = "" if limit is None else f"  (limit {limit})"
         print(f"{mark} {figure:<{width}} {value}{lim}")
         if offenders and (args.list or not ok):
             for item in offenders:
                 print(f"       {item}" if isinstance(item, str) else
                       f"       {item[0]}  {item[1]} lines")
-    print(f"{len(rows) - failed} of {len(rows)} figures within their limits")
+    print(f"{len(rows) - failed - n_open} of {len(rows)} figures within their limits"
+          + (f", {n_open} known open" if n_open else ""))
     return 1 if failed else 0
 
 

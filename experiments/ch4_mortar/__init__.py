@@ -37,9 +37,8 @@ The choices where the thesis is silent, the parameters and the model problem
 from __future__ import annotations
 
 import dataclasses
-import time
 
-from hpfebe.suite import ArtefactResult, from_config
+from hpfebe.suite import ArtefactResult, from_config, select_scenes, timed
 
 from .scene import QUICK_ADAPT, Params, _problem
 from .table import (convergence_sweep, damping_sweep, figure_4_17, figure_4_18,
@@ -60,9 +59,7 @@ SCENES = {"table": ("table_4_1", "figure_4_17"), "sweep": ("figure_4_18",),
 def _table_problem(prm: Params):
     """The Table 4.1 problem (p = table_p on the table_n meshes), shared by the DtN
     artefacts on that mesh, and its set-up time."""
-    t = time.perf_counter()
-    pr = _problem(prm, prm.table_n[0], prm.table_n[1], prm.table_p, prm.table_p)
-    return pr, time.perf_counter() - t
+    return timed(_problem, prm, prm.table_n[0], prm.table_n[1], prm.table_p, prm.table_p)
 
 
 def _scene_table(prm: Params, table) -> list[ArtefactResult]:
@@ -89,12 +86,8 @@ def run(config: dict, quick: bool = False, scenes=None) -> list[ArtefactResult]:
     prm = from_config(Params, config, "ch4_mortar")
     if quick and "adapt_steps" not in (config or {}):
         prm = dataclasses.replace(prm, adapt_steps=QUICK_ADAPT[0], adapt_show=QUICK_ADAPT[1])
-    scenes = tuple(SCENES) if scenes is None else tuple(scenes)
-    unknown = [s for s in scenes if s not in SCENES]
-    if unknown:
-        raise ValueError(f"ch4_mortar: unknown scenes {unknown}; known: {list(SCENES)}")
     table, out = None, []
-    for name in (s for s in SCENES if s in scenes):     # in the order of SCENES
+    for name in select_scenes(SCENES, scenes, "ch4_mortar"):     # in the order of SCENES
         f, on_table_mesh = _SCENE_RUNS[name]
         if on_table_mesh and table is None:
             table = _table_problem(prm)

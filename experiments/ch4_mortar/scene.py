@@ -135,21 +135,40 @@ class Params:
     compare_tols: tuple[float, ...] = (1e-2, 1e-4, 1e-6, 1e-8, 1e-10)
 
     def __post_init__(self):
-        for name in ("E", "rho", "tol_dtn", "tol_uzawa", "radius", "iteration_factor",
-                     "magnification"):
-            if not getattr(self, name) > 0:
-                raise ValueError(f"{name} must be positive, got {getattr(self, name)!r}")
+        numbers = (       # (test, what it asks, the fields), the tolerances > 0: reachable
+            (lambda v: v > 0, "positive", ("E", "rho", "tol_dtn", "tol_uzawa", "radius",
+                                           "iteration_factor", "magnification",
+                                           "rho_global", "tol_global")),
+            (lambda v: v >= 0, ">= 0", ("F", "mu_f")),
+            (lambda v: v >= 1, ">= 1", ("max_dtn", "max_uzawa", "table_max_dtn",
+                                        "max_global", "max_rho_iter", "table_p", "adapt_p",
+                                        "adapt_steps", "conv_table_n1_max")),
+            (lambda q: 0 < q <= 1, "in (0, 1]", ("adapt_q1", "adapt_q2")))  # Algorithm 4.6
+        lists = (         # (test of each entry, what it asks, the non-empty list fields)
+            (lambda w: 0 < w <= 1, "values in (0, 1]", ("omegas", "conv_omega",
+                                                        "map_omegas")),   # dampings
+            (lambda n: n >= 4 and n % 4 == 0, "multiples of 4 (n2 = 3 n1 / 4)",
+             ("conv_n1",)),
+            (lambda pq: len(pq) == 2 and min(pq) >= 1, "pairs [p1, p2] of degrees >= 1",
+             ("conv_degrees", "conv_table_degrees")),
+            (lambda v: v > 0, "positive values", ("rho_ratios", "compare_tols")))
+        for test, what, names in numbers:
+            for name in names:
+                if not test(getattr(self, name)):
+                    raise ValueError(f"{name} must be {what}, got {getattr(self, name)!r}")
+        for test, what, names in lists:
+            for name in names:
+                if not getattr(self, name) or not all(map(test, getattr(self, name))):
+                    raise ValueError(f"{name} must be {what}, got {getattr(self, name)!r}")
+        for name in ("table_n", "rho_n", "adapt_n", "coulomb_n", "conv_omega"):   # pairs
+            if len(getattr(self, name)) != 2 or not min(getattr(self, name)) > 0:
+                raise ValueError(f"{name} must be a pair of positive entries, got "
+                                 f"{getattr(self, name)!r}")
         for name, ok in (("table_friction", ("tresca", "coulomb")),
                          ("table_transfer", ("functional", "function")),
                          ("geometry", ("arc", "flat"))):
             if getattr(self, name) not in ok:
                 raise ValueError(f"{name} must be one of {ok}, got {getattr(self, name)!r}")
-        if any(not 0 < w <= 1 for w in self.omegas + self.conv_omega):
-            raise ValueError("omegas and conv_omega must lie in (0, 1]")
-        if any(n % 4 for n in self.conv_n1):
-            raise ValueError(f"conv_n1 must be multiples of 4 (n2 = 3 n1 / 4), got "
-                             f"{self.conv_n1!r}")
-
 
 def _problem(prm: Params, n1, n2, p1, p2, bem_cache: dict | None = None, gap=None):
     return model_problem(n1, n2, p1, p2, prm.E, prm.nu, prm.F, (0.0, prm.u_top), prm.radius,

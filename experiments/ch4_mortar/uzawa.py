@@ -13,7 +13,7 @@ from matplotlib.figure import Figure
 from hpfebe.constitutive import lame_constants
 from hpfebe.scenes import adaptive_model_problem
 from hpfebe.solvers import SemismoothSettings
-from hpfebe.suite import ArtefactResult, Claim, progress
+from hpfebe.suite import ArtefactResult, Claim, new_figure, progress, style_axes, timed
 
 from .scene import CHOICES, Params, _dof, _dtn_settings, _global_settings, _problem
 from .table import _plot_bodies
@@ -26,8 +26,8 @@ def _plot_4_19(prm: Params, pr, sol) -> Figure:
     x = pr.points[:, 0]
     order = np.argsort(x)
     on = x[pn > 1e-8 * pn.max()]
-    fig = Figure(figsize=(14, 4.8), layout="constrained")
-    ax0, ax1, ax2 = fig.subplots(1, 3, width_ratios=(0.8, 1.4, 1.4))
+    fig, (ax0, ax1, ax2) = new_figure((14, 4.8), 1, 3, width_ratios=(0.8, 1.4, 1.4),
+                                      layout="constrained")
     n1, n2 = prm.coulomb_n
     _plot_bodies(ax0, pr, sol, prm.magnification, reference=True)
     ax0.set_title(f"deformed (x{prm.magnification:g}), h1:h2 = {n1}:{n2}, p = 2", fontsize=9)
@@ -52,12 +52,11 @@ def _plot_4_19(prm: Params, pr, sol) -> Figure:
 
 
 def figure_4_19(prm: Params) -> ArtefactResult:
-    t = time.perf_counter()
     n1, n2 = prm.coulomb_n
     bems = {}                        # the BE bodies, shared with the gap-free reading
-    pr = _problem(prm, n1, n2, 2, 2, bems)
-    sol = pr.global_uzawa(_global_settings(prm))
-    run_s = time.perf_counter() - t
+    pr, setup_s = timed(_problem, prm, n1, n2, 2, 2, bems)
+    sol, solve_s = timed(pr.global_uzawa, _global_settings(prm))
+    run_s = setup_s + solve_s
     pn, pt = sol.extra["pn"], sol.extra["pt"]
     order = np.argsort(pr.points[:, 0])
     fig = _plot_4_19(prm, pr, sol)
@@ -165,12 +164,10 @@ def _plot_hp_mesh(ax, meshes, title):
 
 
 def figure_4_20(prm: Params) -> ArtefactResult:
-    t = time.perf_counter()
-    hist, counts = adaptive_model_problem(    # Algorithm 4.6 on both bodies
-        _global_settings(prm), prm.adapt_steps + 1, prm.adapt_n, prm.adapt_p,
-        (prm.adapt_q1, prm.adapt_q2), prm.radius, E=prm.E, nu=prm.nu, F=prm.F,
+    (hist, counts), run_s = timed(            # Algorithm 4.6 on both bodies
+        adaptive_model_problem, _global_settings(prm), prm.adapt_steps + 1, prm.adapt_n,
+        prm.adapt_p, (prm.adapt_q1, prm.adapt_q2), prm.radius, E=prm.E, nu=prm.nu, F=prm.F,
         u_top=(0.0, prm.u_top), plane=prm.plane)
-    run_s = time.perf_counter() - t
     rows = []
     for rec, meshes in zip(hist.records, hist.meshes):
         rows.append(dict(step=rec["step"], dof_1=rec["ndof"][0], dof_2=rec["ndof"][1],
@@ -181,8 +178,8 @@ def figure_4_20(prm: Params) -> ArtefactResult:
                          n_marked_1=rec["n_marked"][0], n_marked_2=rec["n_marked"][1]))
     df = pd.DataFrame(rows)
     show = [k for k in prm.adapt_show if k < len(hist.meshes)]
-    fig = Figure(figsize=(4 * (len(show) + 1), 5))
-    axes = np.atleast_1d(fig.subplots(1, len(show) + 1))
+    fig, axes = new_figure((4 * (len(show) + 1), 5), 1, len(show) + 1)
+    axes = np.atleast_1d(axes)
     for ax, k in zip(axes, [0] + show):
         _plot_hp_mesh(ax, hist.meshes[k], f"step {k}: DOF {sum(hist.records[k]['ndof'])}, "
                       f"p_max {max(int(m.degrees.max()) for m in hist.meshes[k])}")
@@ -217,17 +214,14 @@ def figure_uzawa_rho(prm: Params) -> ArtefactResult:
                              iterations=sol.info.iterations, converged=sol.info.converged,
                              reason=sol.info.reason))
     df = pd.DataFrame(rows)
-    fig = Figure(figsize=(6, 4.5))
-    ax = fig.subplots()
+    fig, ax = new_figure((6, 4.5))
     for law, g in df.groupby("friction"):
         ok = g[g["converged"]]
         ax.semilogy(ok["rho_over_crit"], ok["iterations"], "o-", label=f"{law} (converged)")
         nc = g[~g["converged"]]
         ax.semilogy(nc["rho_over_crit"], nc["iterations"], "x", ms=8, label=f"{law} (not)")
     ax.axvline(1.0, color="r", ls="--", label="predicted bound rho_crit")
-    ax.set_xlabel("rho / rho_crit")
-    ax.set_ylabel("Uzawa iterations")
-    ax.legend(fontsize=7)
+    style_axes(ax, "rho / rho_crit", "Uzawa iterations", legend=dict(fontsize=7), grid=False)
     largest = df[df["converged"]].groupby("friction")["rho_over_crit"].max().to_dict()
     smallest_bad = df[~df["converged"]].groupby("friction")["rho_over_crit"].min().to_dict()
     below = df[df["rho_over_crit"] < 1.0]
@@ -247,9 +241,8 @@ def _timed(f, repeats: int = 3):
     scatter by tens of per cent)."""
     walls = []
     for _ in range(repeats):
-        t = time.perf_counter()
-        sol = f()
-        walls.append(time.perf_counter() - t)
+        sol, wall = timed(f)
+        walls.append(wall)
     return sol, min(walls)
 
 
@@ -260,8 +253,7 @@ def _plot_solver_comparison(df: pd.DataFrame) -> Figure:
     from matplotlib.transforms import blended_transform_factory
 
     pos = df.loc[df["rel_difference"] > 0, "rel_difference"]
-    fig = Figure(figsize=(11, 5), layout="constrained")
-    axes = fig.subplots(1, 2, sharey=True)
+    fig, axes = new_figure((11, 5), 1, 2, sharey=True, layout="constrained")
     for ax, (law, g) in zip(axes, df.groupby("friction", sort=False)):
         edge = blended_transform_factory(ax.transData, ax.transAxes)
         for k, (name, h) in enumerate(g.groupby("method", sort=False)):

@@ -33,7 +33,7 @@ import time
 import numpy as np
 import pandas as pd
 
-from hpfebe.suite import ArtefactResult, Claim, from_config
+from hpfebe.suite import ArtefactResult, Claim, from_config, select_scenes, timed
 
 from .claims import (bebe_curve_claim, bebe_field_claims, bebe_mesh_claim, coupling_claim,
                      dent_claim, mesh_claims, zone_claim)
@@ -114,9 +114,7 @@ def example2(prm: Params) -> list[ArtefactResult]:
     t0 = time.perf_counter()
     runs = all_runs(prm, (2,))
     bebe = bebe_runs(prm, runs)
-    t_study = time.perf_counter()
-    study = bebe_mesh_study(prm, runs, bebe)
-    t_study = time.perf_counter() - t_study
+    study, t_study = timed(bebe_mesh_study, prm, runs, bebe)
     bb_runs = [(f"BE/BE theta={th:g}", pair["BE/BE"]) for th, pair in bebe.items()]
     st_runs = [(f"BE/BE study h={h:g}", p["BE/BE"]) for h, p in study.items()
                if h != prm.bebe_h]
@@ -161,16 +159,12 @@ def run(config: dict, quick: bool = False, scenes=None) -> list[ArtefactResult]:
     """Figures 4.1-4.12 (config/quick.yaml sets the sizes); scenes: names of
     :data:`SCENES` to compute (None: all)."""
     prm = from_config(Params, config, scene="ch4_plasticity")
-    scenes = tuple(SCENES) if scenes is None else tuple(scenes)
-    unknown = sorted(set(scenes) - set(SCENES))
-    if unknown:
-        raise ValueError(f"unknown scenes {unknown}; ch4_plasticity has {list(SCENES)}")
+    scenes = select_scenes(SCENES, scenes, "ch4_plasticity")
     out = []
     for name, scene in (("ex1", example1), ("ex2", example2)):
         if name in scenes:
-            t0 = time.perf_counter()
-            res = scene(prm)
+            res, scene_s = timed(scene, prm)
             for r in res:
-                r.meta["scene_s"] = time.perf_counter() - t0
+                r.meta["scene_s"] = scene_s
             out += res
     return out

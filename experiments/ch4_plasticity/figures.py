@@ -12,6 +12,7 @@ from matplotlib.figure import Figure
 from hpfebe.io import fe_vtu
 from hpfebe.scenes import stamp_interior
 from hpfebe.scenes import plasticity
+from hpfebe.suite import new_figure, style_axes
 
 from .scene import Params
 
@@ -66,8 +67,8 @@ def _grid(stamp, prm: Params):
 
 def field_figure(prm: Params, run: plasticity.Run, field: str | None, title: str) -> Figure:
     snaps = [t.peak for t in run.touches if t.peak is not None]
-    fig = Figure(figsize=(5.0 * len(snaps), 3.9))
-    axes = fig.subplots(1, len(snaps), squeeze=False)[0]
+    fig, axes = new_figure((5.0 * len(snaps), 3.9), 1, len(snaps), squeeze=False)
+    axes = axes[0]
     vmax = max(float(s.fields["eps_p_norm"].max()) for s in snaps) if field else 0.0
     for ax, s in zip(axes, snaps):
         pc = _draw(ax, prm, s, run.fe, field, vmax or 1.0)
@@ -86,8 +87,7 @@ def bebe_figure(prm: Params, bebe: dict, field: str | None, title: str) -> Figur
     if snap is None:
         return missing_figure("BE/BE: no converged state (see the claims)")
     be, mag = bebe["BE/BE"].fe, prm.magnification
-    fig = Figure(figsize=(5.5, 4.0))
-    ax = fig.subplots()
+    fig, ax = new_figure((5.5, 4.0))
     pw = be.cells.nodes + mag * snap.fields["node_u"]
     ps, us, cs = stamp_interior(snap.stamp, snap.u_stamp, *_grid(snap.stamp, prm))
     kw = dict(edgecolors="k", linewidths=0.2)
@@ -114,8 +114,7 @@ def curve_figure(prm: Params, runs: dict, example: int, bebe: dict | None = None
     last panel: the FE/FE mesh study (B-bar, full Q1) and the BE/BE mesh study."""
     th0 = prm.thetas
     ncol = len(th0) + 1
-    fig = Figure(figsize=(4.8 * ncol, 4.2))
-    axes = fig.subplots(1, ncol)
+    fig, axes = new_figure((4.8 * ncol, 4.2), 1, ncol)
     for ax, th in zip(axes, th0):
         for st, style, kw in (("FE", "-o", dict(ms=6, mfc="none")), ("BE", "--s",
                                                                       dict(ms=3))):
@@ -135,10 +134,10 @@ def curve_figure(prm: Params, runs: dict, example: int, bebe: dict | None = None
             f = bebe[th]["FE/FE"]
             ax.plot([0.0, *f.load_curve("force")], [0.0, *f.load_curve()], "-", lw=0.8,
                     color="grey", label=f"FE/FE (h = {f.h:g}, same mesh as BE/BE)")
-        ax.set_title(f"theta = {th:g}, h = {prm.h_figure:g}", fontsize=9)
-        ax.set_xlabel("applied force (bottom reaction)")
-        ax.set_ylabel(f"||dev sigma|| at X = {plasticity.POINT[example]}")
-        ax.legend(fontsize=7)
+        style_axes(ax, "applied force (bottom reaction)",
+                   f"||dev sigma|| at X = {plasticity.POINT[example]}",
+                   f"theta = {th:g}, h = {prm.h_figure:g}", title_size=9,
+                   legend=dict(fontsize=7), grid=False)
     ax = axes[-1]
     last = len(plasticity.STAMPS[example])
     for i, h in enumerate(prm.h_levels):
@@ -156,10 +155,9 @@ def curve_figure(prm: Params, runs: dict, example: int, bebe: dict | None = None
         if r.records:
             ax.plot([0.0, *r.load_curve("force")], [0.0, *r.load_curve()], "-.^", ms=2,
                     color=f"C{len(prm.h_levels) + i}", label=f"BE/BE h={h:.3g}")
-    ax.set_title(f"mesh study, theta = {th0[0]:g}, touch {last}", fontsize=9)
-    ax.set_xlabel("applied force")
-    ax.set_ylabel(f"||dev sigma|| at X = {plasticity.POINT[example]}")
-    ax.legend(fontsize=7)
+    style_axes(ax, "applied force", f"||dev sigma|| at X = {plasticity.POINT[example]}",
+               f"mesh study, theta = {th0[0]:g}, touch {last}", title_size=9,
+               legend=dict(fontsize=7), grid=False)
     fig.tight_layout()
     return fig
 
@@ -184,8 +182,7 @@ def vtu_exports(prm: Params, run: plasticity.Run, tag: str) -> dict:
 
 
 def missing_figure(text: str) -> Figure:
-    fig = Figure(figsize=(6, 2))
-    ax = fig.subplots()
+    fig, ax = new_figure((6, 2))
     ax.axis("off")
     ax.text(0.5, 0.5, text, ha="center", va="center", wrap=True, fontsize=9)
     return fig

@@ -37,7 +37,9 @@ CHOICES = (
     "Newton: each increment starts from the secant extrapolation of the last two converged "
     "states (at the first unloading increment: the work piece lowered rigidly, the stamp "
     "at rest), or from TwoBodyContact's bonded predictor when that lowers ||R||; Armijo "
-    "line search on ||R||, stop at ||R|| <= rtol x force scale + rtol sigma_Y width; a "
+    "line search on ||R||, stop at ||R|| <= rtol x force scale + rtol x the reference "
+    "force (the work piece's width times the smaller of sigma_Y and the elastic stress of "
+    "the lift: scenes.stamping.reference_force; sigma_Y in every thesis scene); a "
     "failed increment is halved (at most max_cuts times).",
     "Plastic zone = elements with mean ||eps_p|| > zone_tol.",
     "Newton systems with an FE body: SuperLU with minimum degree ordering on A^T + A and "
@@ -123,6 +125,8 @@ class Params(plasticity.StampingScene):
         super().__post_init__()
         if not self.thetas or any(not 0 <= t <= 1 for t in self.thetas):
             raise ValueError(f"thetas must be values in [0, 1], got {self.thetas!r}")
+        if not self.h_levels or any(not h > 0 for h in self.h_levels):
+            raise ValueError(f"h_levels must be positive mesh sizes, got {self.h_levels!r}")
         if self.h_figure not in self.h_levels:
             raise ValueError(f"h_figure must be one of h_levels {self.h_levels!r}, got "
                              f"{self.h_figure!r}")

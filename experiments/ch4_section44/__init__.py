@@ -46,9 +46,8 @@ them; readings that are not derived are hypotheses.
 from __future__ import annotations
 
 import functools
-import time
 
-from hpfebe.suite import ArtefactResult, from_config
+from hpfebe.suite import ArtefactResult, from_config, select_scenes, timed
 
 from .dtn import mortar_sweep, table_4_2
 from .fields import figures
@@ -68,19 +67,13 @@ def run(config: dict, quick: bool = False, scenes=None) -> list[ArtefactResult]:
     """The artefacts of the scenes asked for (:data:`SCENES`; None: all); ``quick`` is
     unused: config/quick.yaml sets the sizes."""
     prm = from_config(Params, config, scene="ch4_section44")
-    scenes = tuple(SCENES) if scenes is None else tuple(scenes)
-    unknown = sorted(set(scenes) - set(SCENES))
-    if unknown:
-        raise ValueError(f"unknown scene(s) {unknown} of ch4_section44; known: "
-                         f"{list(SCENES)}")
+    scenes = select_scenes(SCENES, scenes, "ch4_section44")
     solve = penalty_solver()            # scenes run together share their penalty runs
     out = {}
     if "penalty" in scenes:
         out["table_4_3"] = table_4_3(prm, solve)
     if "dtn" in scenes:
-        t0 = time.perf_counter()
-        pr = mortar_scene(prm)
-        setup = time.perf_counter() - t0
+        pr, setup = timed(mortar_scene, prm)
         tab, sols = mortar_sweep(prm, pr)
         out["table_4_2"] = table_4_2(prm, pr, tab, sols, setup)
     if "fields" in scenes:

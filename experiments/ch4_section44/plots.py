@@ -9,6 +9,8 @@ import pandas as pd
 from matplotlib.collections import PolyCollection
 from matplotlib.figure import Figure
 
+from hpfebe.suite import new_figure
+
 from .scene import (PUB_DEV_MAX, PUB_MORTAR_DEV_MAX, PUB_MORTAR_UX, PUB_MORTAR_UY, PUB_UX,
                     PUB_UY, Run)
 
@@ -57,9 +59,8 @@ def _displacement_panels(bodies: dict):
     """The 2 x 3 figure of Figures 4.21/4.22 with u_x, u_y of the work piece (row 1) and
     the stamp (row 2) drawn in the first two columns; the rows' heights follow the
     bodies' shapes (work piece 4 x 2, stamp 1 x 2)."""
-    fig = Figure(figsize=(13, 7.8), layout="constrained")
+    fig, axes = new_figure((13, 7.8), 2, 3, height_ratios=(1.0, 1.6), layout="constrained")
     fig.get_layout_engine().set(w_pad=0.15, wspace=0.12)
-    axes = fig.subplots(2, 3, height_ratios=(1.0, 1.6))
     for row, b in enumerate(("work", "stamp")):
         p, cells, u = bodies[b]
         for c in (0, 1):

@@ -52,12 +52,14 @@ def test_wrong_S_shape_named(body):
         solve_penalty(body, 1e-5, -D, S=np.eye(3))
 
 
-def test_scalar_gap_callable_is_a_constant(body):
-    a = solve_penalty(body, 1e-5, -D)
-    b = solve_penalty(body, 1e-5, lambda x: -D)
-    c = solve_friction(body, 1e-5, 1e-5, lambda x: -D, friction="coulomb", mu_f=0.3)
-    assert a.converged and b.converged and c.converged
-    assert np.array_equal(a.U, b.U)
+def test_scalar_gap_callable_is_refused(body):
+    """Issue 25: a gap callable must return one value per point (a scalar may be a
+    constant or ``norm(x) - 1`` of all points at once); a constant gap is a float."""
+    for solve in (lambda: solve_penalty(body, 1e-5, lambda x: -D),
+                  lambda: solve_friction(body, 1e-5, 1e-5, lambda x: -D,
+                                         friction="coulomb", mu_f=0.3)):
+        with pytest.raises(ValueError, match=r"gap\(x\) must have shape \(\d+,\)"):
+            solve()
 
 
 def test_extreme_eps_is_not_reported_as_converged(body):

@@ -8,7 +8,8 @@ import numpy as np
 import pytest
 
 from hpfebe.contact import NeumannSettings
-from hpfebe.contact.mortar_fe import FEMortarContact, fe_trace_mesh
+from hpfebe.contact.mortar_fe import FEMortarContact
+from hpfebe.coupling.mortar import fe_trace_mesh
 from hpfebe.fem import rectangle_mesh
 from hpfebe.scenes import READINGS, DtNReadings, dtn_settings, section44_scene
 

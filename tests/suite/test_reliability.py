@@ -151,9 +151,9 @@ def hpfebe(*args, timeout=300):
 
 
 @pytest.mark.parametrize("make, match", [
-    (lambda m: LameBEM(m, 1.0, "0.3"), "nu .*must be a number"),
-    (lambda m: LameBEM(m, "1", 0.3), "E .*must be a number"),
-    (lambda m: LameBEM(m, True, 0.3), "E .*must be a number"),
+    (lambda m: LameBEM(m, 1.0, "0.3"), "nu .*must be a .*number"),
+    (lambda m: LameBEM(m, "1", 0.3), "E .*must be a .*number"),
+    (lambda m: LameBEM(m, True, 0.3), "E .*must be a .*number"),
     (lambda m: LaplaceBEM(m, scale="2"), "scale"),
     (lambda m: LaplaceBEM(m, zero_flux="no"), "zero_flux"),    # "no" is truthy
     (lambda m: LameBEM(m, 1.0, 0.3, zero_force="False"), "zero_force"),

@@ -97,9 +97,9 @@ def test_registry_cache_written_by_the_main_snakemake(tree):
     assert r.returncode == 0, r.stdout + r.stderr
     stamp, cached = pickle.loads((tree / ".snakemake" / "hpfebe" / "registry.pickle")
                                  .read_bytes())
-    fresh = _registry_module().discover(tree / "experiments")
+    fresh = _registry_module().discover(ROOT / "experiments")   # the Snakefile's own
     assert [j.rule for j in cached.jobs] == [j.rule for j in fresh.jobs]
-    assert str(tree / "experiments" / "registry.py") in stamp
+    assert str(ROOT / "experiments" / "registry.py") in stamp
 
 
 def test_one_rule_per_job(tree):

@@ -38,6 +38,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..checks import array, choice, integer, real
 from ..fem.meshes import refine_labelled
 from .marking import MARKERS
 
@@ -99,8 +100,7 @@ def _per_mesh(value, n: int, name: str) -> list:
 
 def _check_marking(markings, thetas) -> None:
     for marking, theta in zip(markings, thetas):
-        if marking not in MARKINGS:
-            raise ValueError(f"marking must be one of {list(MARKINGS)}, got {marking!r}")
+        choice("marking", marking, MARKINGS)
         if marking != "uniform":
             MARKERS[marking](np.ones(1), theta)  # validates theta early
 
@@ -115,10 +115,8 @@ def adapt(mesh, solve, estimate, n_steps: int, theta=0.9, marking="max", refine=
     estimated but not refined) on one mesh or a tuple of meshes (module doc).
     ``progress`` optionally wraps the step range (e.g. a progress bar).  Returns an
     :class:`AdaptiveHistory`."""
-    if int(n_steps) != n_steps or n_steps < 1:
-        raise ValueError(f"n_steps must be an integer >= 1, got {n_steps!r}")
-    if not (math.isfinite(tol) and tol >= 0):
-        raise ValueError(f"tol must be a finite number >= 0, got {tol!r}")
+    n_steps = integer("n_steps", n_steps, lo=1)
+    tol = real("tol", tol, nonnegative=True)
     several = isinstance(mesh, (tuple, list))
     meshes = list(mesh) if several else [mesh]
     n = len(meshes)
@@ -137,13 +135,13 @@ def adapt(mesh, solve, estimate, n_steps: int, theta=0.9, marking="max", refine=
         t1 = time.perf_counter()
         etas = estimate(current, state)
         t2 = time.perf_counter()
-        etas = [np.asarray(e, dtype=float) for e in (etas if several else [etas])]
-        ndofs = [int(d) for d in (ndof if several else [ndof])]
+        # a NaN indicator would silently disable marking: refused, naming the step
+        etas = [array(f"eta (indicators of mesh {i} at step {k})", e, ndim=1)
+                for i, e in enumerate(etas if several else [etas])]
+        ndofs = [integer("ndof (from solve)", d, lo=0) for d in (ndof if several else [ndof])]
         if len(etas) != n or len(ndofs) != n:
             raise ValueError(f"estimate and solve must give one entry per mesh ({n}), got "
                              f"{len(etas)} indicator arrays and {len(ndofs)} dof counts")
-        if not all(np.all(np.isfinite(e)) for e in etas):
-            raise FloatingPointError(f"estimator returned non-finite indicators at step {k}")
         totals = [float(np.sqrt(np.sum(e ** 2))) for e in etas]
         total = float(np.sqrt(np.sum([np.sum(e ** 2) for e in etas]))) if several else totals[0]
         err = float(error(current, state)) if error is not None else math.nan

@@ -58,7 +58,8 @@ import numpy as np
 import scipy.linalg as sla
 
 from ..analysis.norms import energy_error_dirichlet, energy_error_neumann, neumann_functional
-from ..constitutive.laws import penalty_friction, positive
+from ..checks import array, callable_returning, real
+from ..constitutive.laws import penalty_friction
 from ..quadrature import gauss_legendre
 from ._ongamma import grad_single_layer_on_gamma
 
@@ -285,12 +286,12 @@ def contact_traction(op, U, gap, eps_n: float, eps_t: float, mu_f=None, F=None, 
     U_n <= g), Coulomb (``mu_f``) or Tresca (``F``), ``slip`` the accumulated slip (0:
     one load step)."""
 
-    positive("eps_n", eps_n)
-    positive("eps_t", eps_t)
-    if not callable(gap):
-        raise ValueError(f"gap must be a callable g(x), got {type(gap).__name__}")
-    Ul = np.asarray(U, dtype=float).reshape(-1, 2)
+    real("eps_n", eps_n, positive=True)
+    real("eps_t", eps_t, positive=True)
     mesh = op.mesh
+    # g(x) one value per point (a scalar is refused), no NaN (+inf: no obstacle there)
+    gap = callable_returning("gap", gap, None, lambda x: (len(x),), allow_inf=True)
+    Ul = array("U", U, shape=(op.V_space.ndof * 2,)).reshape(-1, 2)
 
     def f(x, n, elem, t):
         u = op.V_space.evaluate(Ul, elem, t)
@@ -326,9 +327,7 @@ def lame_contact_indicators(op, U, Psi, gap, eps_n: float, eps_t: float, mu_f=No
     ``tractions`` (label -> callable, e.g. t_hat on "N").  ``residuals``: precomputed
     ``lame_boundary_residuals(op, U, Psi, nq)`` (shared by indicator variants that differ
     in ``weight`` only)."""
-    weight = float(weight)
-    if not (np.isfinite(weight) and weight > 0):
-        raise ValueError(f"weight must be finite and positive, got {weight!r}")
+    weight = real("weight", weight, positive=True)
     data = dict(tractions or {})
     data[contact_label] = contact_traction(op, U, gap, eps_n, eps_t, mu_f=mu_f, F=F)
     _, parts = lame_bem_indicators(op, U, Psi, data, nq=nq, return_parts=True,

@@ -31,6 +31,7 @@ import numpy as np
 from skfem import Basis, ElementQuad1, ElementTriP1, FacetBasis, Functional, InteriorFacetBasis
 from skfem.helpers import grad
 
+from ..checks import array, integer
 from ..fem.meshes import cell_diameter, facet_containing
 from ..constitutive.materials import lame_constants, linear_stress
 
@@ -81,17 +82,14 @@ def fe_indicators(basis: Basis, U, f=None, tractions: dict | None = None,
     elem = basis.elem
     nc = mesh.t.shape[1]
     hK = cell_diameter(mesh)
-    U = np.asarray(U, dtype=float)
-    if U.shape != (basis.N,):
-        raise ValueError(f"U must have {basis.N} entries (basis.N), got shape {U.shape}")
+    U = array("U", U, shape=(basis.N,))
     sig = (lambda G: G) if stress is None else stress
     scalar = getattr(elem, "elem", elem)   # ElementVector wraps the scalar element
     if not isinstance(scalar, (ElementTriP1, ElementQuad1)):
         raise ValueError("basis element must be P1 or Q1 (div sigma(U) = 0 per cell), got "
                          f"{type(scalar).__name__}: scikit-fem's H1 elements provide no "
                          "second derivatives for the volume residual of higher degrees")
-    if intorder is None:
-        intorder = 4
+    intorder = 4 if intorder is None else integer("intorder", intorder, lo=1)
 
     # volume residual h_K^2 ||f + div sigma(U)||^2 (div sigma(U) = 0 for P1, Q1 on rectangles)
     vol = np.zeros(nc)

@@ -18,22 +18,16 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..checks import array, real
+
 
 def _check(eta, theta):
-    eta = np.asarray(eta, dtype=float)
-    if eta.ndim != 1 or eta.size == 0:
-        raise ValueError(f"eta must be a non-empty 1D array of indicators, got shape {eta.shape}")
-    if not np.all(np.isfinite(eta)) or np.any(eta < 0):
-        raise ValueError("eta must be finite and non-negative, got "
-                         f"min={np.nanmin(eta) if np.any(~np.isnan(eta)) else 'nan'}, "
-                         f"non-finite entries: {int(np.sum(~np.isfinite(eta)))}")
-    try:
-        theta = float(theta)
-    except (TypeError, ValueError):
-        raise ValueError(f"theta must be a number in (0, 1], got {theta!r}") from None
-    if not (0.0 < theta <= 1.0):
-        raise ValueError(f"theta must lie in (0, 1], got {theta!r}")
-    return eta, theta
+    eta = array("eta (indicators)", eta, ndim=1, min_size=1)
+    if np.any(eta < 0):
+        k = int(np.argmin(eta))
+        raise ValueError(f"eta (indicators) must be non-negative, got {eta[k]!r} on "
+                         f"element {k}")
+    return eta, real("theta", theta, lo=0.0, hi=1.0, lo_open=True)
 
 
 def mark_max(eta, theta: float = 0.9) -> np.ndarray:

@@ -8,6 +8,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from ..checks import array, instance, integer, real
 from ..geometry import BoundaryMesh
 from ..quadrature import gauss_legendre
 from .adaptive import adapt
@@ -59,7 +60,7 @@ def mortar_indicators(pr: MortarContact, sol: MortarSolution, nq: int | None = N
     # jump terms on Gamma^1_C
     mesh = b1.mesh
     els = np.flatnonzero(mesh.labels == "C")
-    q = int(mesh.degrees.max()) + 3 if nq is None else int(nq)
+    q = int(mesh.degrees.max()) + 3 if nq is None else integer("nq", nq, lo=1)
     tq, wq = (np.asarray(v, float) for v in gauss_legendre(q))
     elem = np.repeat(els, q)
     t = np.tile(tq, els.size)
@@ -89,13 +90,13 @@ def mortar_indicators(pr: MortarContact, sol: MortarSolution, nq: int | None = N
 def hp_refine(mesh: BoundaryMesh, marked, eta, h_fraction: float = 0.9) -> BoundaryMesh:
     """Algorithm 4.6 on the marked elements (marked: eta_I >= q1 eta_max): h-refine
     (bisect) where eta_I >= ``h_fraction`` eta_max, raise p by one on the others."""
-    marked = np.asarray(marked, dtype=bool)
-    eta = np.asarray(eta, dtype=float)
-    if eta.shape != marked.shape or marked.shape != (mesh.n_elements,):
-        raise ValueError(f"marked and eta must have one entry per element "
-                         f"({mesh.n_elements}), got {marked.shape}, {eta.shape}")
-    if not 0 < h_fraction <= 1:
-        raise ValueError(f"h_fraction must lie in (0, 1], got {h_fraction!r}")
+    instance("mesh", mesh, BoundaryMesh)
+    marked = array("marked", marked, shape=(mesh.n_elements,), dtype=bool)
+    # a NaN would make eta >= h_fraction * max(eta) false everywhere: no h-refinement
+    eta = array("eta (indicators)", eta, shape=(mesh.n_elements,))
+    if np.any(eta < 0):
+        raise ValueError(f"eta (indicators) must be non-negative, got {eta.min()!r}")
+    h_fraction = real("h_fraction", h_fraction, lo=0.0, hi=1.0, lo_open=True)
     h = marked & (eta >= h_fraction * eta.max())
     p = marked & ~h
     out = mesh.raise_degree(p) if p.any() else mesh
@@ -110,6 +111,8 @@ def hp_adapt(meshes, solve, n_steps: int, q1: float = 0.85, q2: float = 0.9):
     eta_max, else p + 1 (:func:`hp_refine`); ``n_steps`` solves.  Returns (the
     :class:`~hpfebe.adaptivity.AdaptiveHistory`, the number of bisections and degree
     raises per refinement of each body: dicts body, n_h, n_p)."""
+    q1 = real("q1", q1, lo=0.0, hi=1.0, lo_open=True)
+    q2 = real("q2", q2, lo=0.0, hi=1.0, lo_open=True)
     store, counts = {}, []
 
     def estimate(meshes, state):

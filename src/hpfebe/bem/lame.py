@@ -70,6 +70,7 @@ import math
 import numpy as np
 import scipy.sparse as sp
 
+from ..checks import boolean
 from ..constitutive.materials import lame_constants, linear_stress
 from ..geometry import BoundaryMesh
 from ..spaces import ContinuousSpace, DiscontinuousSpace
@@ -81,7 +82,7 @@ from .lowest_order import applies as _closed_form_applies
 from .lowest_order_lame import lame_p1, lame_p1_w
 from .operators import BoundaryOperators, mesh_diameter
 from .potentials import (POT_LAME_DL, POT_LAME_DL_GRAD, POT_LAME_SL, POT_LAME_SL_GRAD,
-                         evaluate_potential)
+                         density, evaluate_potential, evaluation_points)
 
 # The Lame kernels (regular parts) live in kernels.py as LAME_SL, LAME_DL, LAME_HS: the
 # assemblers take kernel ids and the parameter array of kernel_params, read by the
@@ -162,18 +163,15 @@ class LameBEM(BoundaryOperators):
     def __init__(self, mesh: BoundaryMesh, E: float, nu: float, plane: str = "strain",
                  scale: float | None = None, zero_force: bool = True,
                  closed_form: bool = True):
+        self.lam, self.mu = lame_constants(E, nu, plane)       # checks E, nu, plane
         self.E, self.nu, self.plane = float(E), float(nu), plane
-        self.lam, self.mu = lame_constants(E, nu, plane)
         if isinstance(mesh, BoundaryMesh) and scale is None:
             scale = 2.0 * mesh_diameter(mesh)
         super().__init__(mesh, scale, constrained=zero_force)
         self.zero_force = self.constrained
         self.kp = _checked_kernel_params(E, nu, self.lam, self.mu, self.scale)
-        if not isinstance(closed_form, (bool, np.bool_)):
-            raise ValueError(  # noqa: TRY004 - the project's ValueError for bad input
-                f"closed_form must be a bool, got {closed_form!r}")
         # p = 1 everywhere: V, K and Vt by the closed forms, all in one pass
-        self.closed_form = bool(closed_form) and _closed_form_applies(mesh)
+        self.closed_form = boolean("closed_form", closed_form) and _closed_form_applies(mesh)
 
     def _closed(self, key: str) -> None:
         """One pass of the closed forms fills the cache's V, K and Vt (those not there)."""
@@ -251,19 +249,14 @@ class LameBEM(BoundaryOperators):
         u(x) = int G(x,y) psi(y) ds_y - int (T_{n_y} G(x,y)^T) U(y) ds_y,
         ``U`` in V_hp^2, ``psi`` in W_hp^2 (interleaved)."""
         pts, U, psi = self._check_cauchy(points, U, psi)
-        u = evaluate_potential(POT_LAME_SL, self.kp, 2, pts, self.W_space, psi)
-        u -= evaluate_potential(POT_LAME_DL, self.kp, 2, pts, self.V_space, U)
+        u = evaluate_potential(POT_LAME_SL, self.kp, 2, pts, self.W_space, psi, name="psi")
+        u -= evaluate_potential(POT_LAME_DL, self.kp, 2, pts, self.V_space, U, name="U")
         return u
 
     def _check_cauchy(self, points, U, psi):
-        pts = np.ascontiguousarray(np.atleast_2d(np.asarray(points, dtype=float)))
-        if pts.ndim != 2 or pts.shape[1] != 2:
-            raise ValueError(f"points must have shape (n, 2), got {pts.shape}")
-        U = np.asarray(U, dtype=float).reshape(-1, 2)
-        psi = np.asarray(psi, dtype=float).reshape(-1, 2)
-        if U.shape[0] != self.V_space.ndof or psi.shape[0] != self.W_space.ndof:
-            raise ValueError("U must have 2 * V_space.ndof and psi 2 * W_space.ndof entries")
-        return pts, U, psi
+        """(points (n, 2), U (ndof_V, 2), psi (ndof_W, 2)), checked (lengths named)."""
+        return (evaluation_points(points), density("U", U, self.V_space, 2),
+                density("psi", psi, self.W_space, 2))
 
     def displacement_gradient(self, points, U, psi) -> np.ndarray:
         """du_i/dx_m at interior points, shape (n, 2, 2): the x-gradient of Somigliana's

@@ -45,6 +45,7 @@ import math
 
 import numpy as np
 
+from ..checks import boolean
 from ..geometry import BoundaryMesh
 from ..spaces import ContinuousSpace, DiscontinuousSpace
 from .assembly import assemble, sandwich
@@ -52,7 +53,8 @@ from .kernels import INV_2PI, KP_LAPLACE_LOG_R, LAPLACE_DL, LAPLACE_SL
 from .lowest_order import applies as _closed_form_applies
 from .lowest_order import laplace_p1_vk, laplace_p1_w
 from .operators import BoundaryOperators, mesh_diameter
-from .potentials import POT_LAPLACE_DL, POT_LAPLACE_SL, evaluate_potential
+from .potentials import (POT_LAPLACE_DL, POT_LAPLACE_SL, density, evaluate_potential,
+                         evaluation_points)
 
 SINGLE_LAYER_LOGC = np.array([-INV_2PI])
 P1_W_DIRECT_MAX = 512   # p = 1 meshes up to this many elements: W by laplace_p1_w
@@ -91,11 +93,8 @@ class LaplaceBEM(BoundaryOperators):
         super().__init__(mesh, scale, constrained=zero_flux)
         self.zero_flux = self.constrained
         self.kp = _scale_param(self.scale)
-        if not isinstance(closed_form, (bool, np.bool_)):
-            raise ValueError(  # noqa: TRY004 - the project's ValueError for bad input
-                f"closed_form must be a bool, got {closed_form!r}")
         # p = 1 everywhere: V and K by the closed forms, both in one pass
-        self.closed_form = bool(closed_form) and _closed_form_applies(mesh)
+        self.closed_form = boolean("closed_form", closed_form) and _closed_form_applies(mesh)
 
     def _closed_vk(self):
         V, K = laplace_p1_vk(self.W_space, self.V_space, self.scale)
@@ -154,9 +153,13 @@ class LaplaceBEM(BoundaryOperators):
 
     def representation(self, points, U, psi) -> np.ndarray:
         """u(x) = int G(x,y) psi(y) ds_y - int d_{n_y}G(x,y) U(y) ds_y for interior x
-        (formula (1.2) with f = 0); ``U`` in V_hp, ``psi`` in W_hp."""
-        u = evaluate_potential(POT_LAPLACE_SL, self.kp, 1, points, self.W_space, psi)
-        u -= evaluate_potential(POT_LAPLACE_DL, self.kp, 1, points, self.V_space, U)
+        (formula (1.2) with f = 0); ``U`` in V_hp, ``psi`` in W_hp.  ValueError for
+        ``U`` or ``psi`` of the wrong length, non-finite data, or a point on Gamma
+        (:class:`~hpfebe.bem.potentials.PointOnBoundaryError`)."""
+        pts = evaluation_points(points)
+        U, psi = density("U", U, self.V_space, 1), density("psi", psi, self.W_space, 1)
+        u = evaluate_potential(POT_LAPLACE_SL, self.kp, 1, pts, self.W_space, psi, name="psi")
+        u -= evaluate_potential(POT_LAPLACE_DL, self.kp, 1, pts, self.V_space, U, name="U")
         return u[:, 0]
 
 

@@ -29,7 +29,8 @@ from functools import lru_cache
 import numpy as np
 from numba import njit
 
-from ..spaces import P_MAX, eval_basis, gll_tables, n_local
+from .. import checks
+from ..spaces import LEGENDRE, P_MAX, eval_basis, gll_tables, n_local
 from .assembly import rules
 from .integration import _order, point_panels
 from .kernels import (INV_2PI, KP_C1, KP_C1_C2, KP_C1_LOG_R, KP_C2, KP_LAMBDA,
@@ -379,28 +380,60 @@ def _potential(kid, kp, d, nout, pts, mesh, space, coef, gx, gw, gll_x, gll_b):
     return out
 
 
-def evaluate_potential(kid: int, kp, d: int, points, space, coeffs, nout: int | None = None
-                       ) -> np.ndarray:
-    """Values (n_points, nout) of int k(x - y, n_y) f(y) ds_y, f = sum coeffs * basis of
-    ``space`` (``coeffs`` of shape (ndof, d) or (ndof * d,), interleaved); ``nout``
-    defaults to d.  Raises FloatingPointError if a point lies on Gamma."""
-    nout = d if nout is None else int(nout)
-    pts = np.ascontiguousarray(np.atleast_2d(np.asarray(points, dtype=float)))
+class PointOnBoundaryError(ValueError, FloatingPointError):
+    """A potential asked for at a point of Gamma, where the representation formula does
+    not hold (the double layer jumps, the kernels are singular): a ValueError naming the
+    point (and a FloatingPointError, what it was before)."""
+
+
+def evaluation_points(points) -> np.ndarray:
+    """``points`` as a C-contiguous (n, 2) float array (one point (x, y) may be given
+    flat), finite; ValueError naming the first bad point."""
+    pts = checks.array("points", points, finite=False)
+    pts = np.ascontiguousarray(np.atleast_2d(pts))
     if pts.ndim != 2 or pts.shape[1] != 2:
         raise ValueError(f"points must have shape (n, 2), got {pts.shape}")
     bad = ~np.all(np.isfinite(pts), axis=1)
     if np.any(bad):
         k = int(np.argmax(bad))
-        raise ValueError(f"points must be finite: point {k} = {tuple(pts[k])} has a "
-                         "non-finite (NaN or inf) coordinate")
-    coef = np.ascontiguousarray(np.asarray(coeffs, dtype=float).reshape(-1, d))
-    if coef.shape[0] != space.ndof:
-        raise ValueError(f"coeffs must have {space.ndof * d} entries, got {coef.size}")
+        raise ValueError(f"points must be finite: point {k} = {tuple(pts[k].tolist())} "
+                         "has a non-finite (NaN or inf) coordinate")
+    return pts
+
+
+def density(name: str, coeffs, space, d: int) -> np.ndarray:
+    """The coefficients ``coeffs`` of a density in ``space`` with ``d`` components as a
+    C-contiguous (ndof, d) array: given flat (ndof * d,), interleaved, or as (ndof, d);
+    finite.  ValueError naming ``name``, the length it must have and the one it has."""
+    n = space.ndof
+    c = checks.array(name, coeffs)
+    if c.shape not in ((n * d,), (n, d)):
+        which = "W_hp" if space.kind == LEGENDRE else "V_hp"
+        comps = f"{d} x " if d > 1 else ""
+        raise ValueError(f"{name} must have {n * d} entries ({comps}{n} {which} dofs"
+                         f"{', interleaved' if d > 1 else ''}), got shape {c.shape}")
+    return np.ascontiguousarray(c.reshape(n, d))
+
+
+def evaluate_potential(kid: int, kp, d: int, points, space, coeffs, nout: int | None = None,
+                       name: str = "coeffs") -> np.ndarray:
+    """Values (n_points, nout) of int k(x - y, n_y) f(y) ds_y, f = sum coeffs * basis of
+    ``space`` (``coeffs`` of shape (ndof, d) or (ndof * d,), interleaved; ``name``: the
+    caller's name of it, for the error messages); ``nout`` defaults to d.  Raises
+    :class:`PointOnBoundaryError` (a ValueError) if a point lies on Gamma."""
+    nout = d if nout is None else int(nout)
+    pts = evaluation_points(points)
+    coef = density(name, coeffs, space, d)
     mesh = space.mesh
     gx, gw, _, _ = rules()
     gll_x, gll_b = gll_tables(P_MAX)
     kp = np.ascontiguousarray(np.asarray(kp, dtype=float).reshape(-1))
     out = _potential(int(kid), kp, d, nout, pts, mesh, space, coef, gx, gw, gll_x, gll_b)
-    if not np.all(np.isfinite(out)):
-        raise FloatingPointError("potential evaluated on the boundary Gamma")
+    if not np.all(np.isfinite(out)):    # finite points and density: NaN rows are on Gamma
+        on = np.flatnonzero(~np.all(np.isfinite(out), axis=1))
+        k = int(on[0])
+        raise PointOnBoundaryError(
+            f"points must lie off the boundary Gamma, where the representation formula "
+            f"does not hold: point {k} = {tuple(pts[k].tolist())} lies on Gamma "
+            f"({on.size} of {len(pts)} points do); use the boundary data there")
     return out

@@ -42,6 +42,8 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..bem.lame import LameBEM
+from ..checks import (InputTypeError, array, callable_returning, choice, instance,
+                      real)
 from ..fem.elasticity import ElasticBody
 from ..fem.plastic_body import ElastoPlasticFE
 from ..quadrature import gauss_legendre, gauss_lobatto
@@ -110,14 +112,12 @@ class BEBody(_LinearBody):
     kind = "BE"
 
     def __init__(self, bem: LameBEM, S=None):
-        self.body = bem
+        self.body = lame_body(bem)          # a LaplaceBEM has scalar traces: refused
         self.mesh = bem.mesh
         self.space = bem.V_space
         self.ndofs = 2 * self.space.ndof
         self.degree = int(self.mesh.degrees.max())
-        self._S = None if S is None else np.asarray(S, dtype=float)
-        if self._S is not None and self._S.shape != (self.ndofs, self.ndofs):
-            raise ValueError(f"S must have shape {(self.ndofs, self.ndofs)}, got {self._S.shape}")
+        self._S = None if S is None else array("S", S, shape=(self.ndofs, self.ndofs))
         self._K = None
 
     @property
@@ -181,12 +181,10 @@ class BEBody(_LinearBody):
         d = np.asarray(d, dtype=np.int64)
         if component is None:
             return np.sort(np.concatenate([2 * d, 2 * d + 1]))
-        if component not in (0, 1):
-            raise ValueError(f"component must be 0, 1 or None, got {component!r}")
-        return 2 * d + component
+        return 2 * d + choice("component", component, (0, 1))
 
     def dofs_at(self, point: Sequence[float], component: Optional[int] = None):
-        p = np.asarray(point, dtype=float).reshape(1, 2)
+        p = array("point", point, shape=(2,)).reshape(1, 2)
         m = self.mesh
         dist = np.linalg.norm(m.a - p, axis=1)
         e = int(np.argmin(dist))
@@ -212,9 +210,7 @@ class BEBody(_LinearBody):
         ``traction`` a constant (tx, ty) or a callable (x, y) -> (tx, ty)."""
         e_all = self._elements(label)
         if not callable(traction):
-            tc = np.asarray(traction, dtype=float)
-            if tc.shape != (2,):
-                raise ValueError(f"traction must be a pair (tx, ty) or callable, got {traction!r}")
+            tc = array("traction (a pair (tx, ty) or a callable)", traction, shape=(2,))
         m = self.mesh
         f = np.zeros(self.ndofs)
         for p in np.unique(m.degrees[e_all]):
@@ -225,8 +221,9 @@ class BEBody(_LinearBody):
             x = m.points(els[:, None], tq[None, :])             # (ne, nq, 2)
             if callable(traction):
                 tx, ty = traction(x[..., 0], x[..., 1])
-                tv = np.stack([np.broadcast_to(tx, x.shape[:2]),
-                               np.broadcast_to(ty, x.shape[:2])], axis=-1)
+                tv = array("traction(x, y)", np.stack([np.broadcast_to(tx, x.shape[:2]),
+                                                        np.broadcast_to(ty, x.shape[:2])],
+                                                       axis=-1))
             else:
                 tv = np.broadcast_to(tc, x.shape)
             phi = lagrange_values(p, tq)                         # (nq, p+1)
@@ -276,16 +273,12 @@ class PlasticFEBody(FEBody):
     linear = False
 
     def __init__(self, fe: ElastoPlasticFE, offset=None):
-        if not isinstance(fe, ElastoPlasticFE):
-            raise ValueError(f"fe must be an ElastoPlasticFE, got {type(fe).__name__}")
+        instance("fe", fe, ElastoPlasticFE)
         if offset is None:
             self.offset = np.zeros(fe.ndofs)
             geometry = fe.elastic
         else:
-            self.offset = np.asarray(offset, dtype=float).copy()
-            if self.offset.shape != (fe.ndofs,) or not np.all(np.isfinite(self.offset)):
-                raise ValueError(f"offset must be a finite vector of shape ({fe.ndofs},), "
-                                 f"got shape {self.offset.shape}")
+            self.offset = array("offset", offset, shape=(fe.ndofs,), copy=True)
             moved = dataclasses.replace(fe.mesh, doflocs=fe.mesh.p
                                         + fe.elastic.nodal_displacement(self.offset))
             m = fe.material
@@ -307,22 +300,15 @@ class PlasticFEBody(FEBody):
 
 
 def pointwise(name: str, value, pts: np.ndarray, allow_negative: bool = True) -> np.ndarray:
-    """A float or callable x -> values (None = 0), evaluated at the points (n, 2)."""
+    """A float or callable x -> values (None = 0), evaluated at the points (n, 2): a
+    callable must return one finite value per point (a scalar is refused: a constant is
+    given as a float, and ``lambda x: norm(x) - 1`` is no gap of n points)."""
     if value is None:
         return np.zeros(len(pts))
     if callable(value):
-        v = np.asarray(value(pts), dtype=float).reshape(-1)
-        if v.size == 1:                     # a constant written as a function
-            v = np.full(len(pts), v[0])
-        if v.shape != (len(pts),):
-            raise ValueError(f"{name}(x) must return one value per point, got {v.shape}")
+        v = callable_returning(name, value, pts, (len(pts),))(pts)
     else:
-        try:
-            v = np.full(len(pts), float(value))
-        except (TypeError, ValueError):
-            raise ValueError(f"{name} must be a float or a callable, got {value!r}") from None
-    if not np.all(np.isfinite(v)):
-        raise ValueError(f"{name} must be finite on Gamma_C")
+        v = np.full(len(pts), real(f"{name} (a float or a callable of the points)", value))
     if not allow_negative and np.any(v < 0):
         raise ValueError(f"{name} must be >= 0 on Gamma_C, got min {v.min()!r}")
     return v
@@ -330,10 +316,7 @@ def pointwise(name: str, value, pts: np.ndarray, allow_negative: bool = True) ->
 
 def lame_body(bem, name: str = "bem"):
     """``bem`` checked to be a :class:`LameBEM` (a Laplace operator has scalar traces)."""
-    if not isinstance(bem, LameBEM):
-        raise ValueError(f"{name} must be a LameBEM (2D elasticity), got "
-                         f"{type(bem).__name__}")
-    return bem
+    return instance(name, bem, LameBEM, "a LameBEM (2D elasticity)")
 
 
 def against_obstacle(bem, S, contact_label: str, dirichlet_label: str, load):
@@ -347,11 +330,7 @@ def against_obstacle(bem, S, contact_label: str, dirichlet_label: str, load):
         else None
     f = None
     if load is not None:
-        f = np.asarray(load, dtype=float)
-        if f.shape != (body.ndofs,):
-            raise ValueError(f"load must have {body.ndofs} entries, got {f.shape}")
-        if not np.all(np.isfinite(f)):
-            raise ValueError("load must be finite (NaN or inf entries)")
+        f = array("load", load, shape=(body.ndofs,))
     return body, fixed, f
 
 
@@ -367,5 +346,5 @@ def as_body(body, name: str = "body"):
         return FEBody(body)
     if isinstance(body, LameBEM):
         return BEBody(body)
-    raise ValueError(f"{name} must be an ElasticBody, a LameBEM or a contact body, got "
-                     f"{type(body).__name__}")
+    raise InputTypeError(f"{name} must be an ElasticBody, an ElastoPlasticFE, a LameBEM or "
+                         f"a contact body, got an object of type {type(body).__name__}")

@@ -42,6 +42,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..checks import array, choice, integer, real
 from .materials import lame_constants
 
 SQ23 = math.sqrt(2.0 / 3.0)
@@ -88,18 +89,15 @@ class J2Material:
     theta: float = 1.0
 
     def __post_init__(self):
+        # numbers of any real kind (np.float32, a 0-d array) are stored as floats
+        object.__setattr__(self, "E", real("E (Young's modulus)", self.E, positive=True))
+        object.__setattr__(self, "nu", real("nu (Poisson ratio)", self.nu))
         lame_constants(self.E, self.nu, "strain")       # validates E and nu
-        for name in ("sigma_Y", "H", "theta"):
-            v = getattr(self, name)
-            if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
-                raise ValueError(f"{name} must be a finite number, got {v!r}")
-        if not self.sigma_Y > 0:
-            raise ValueError(f"sigma_Y (yield stress) must be positive, got {self.sigma_Y!r}")
-        if self.H < 0:
-            raise ValueError(f"H (hardening modulus) must be >= 0, got {self.H!r}")
-        if not 0.0 <= self.theta <= 1.0:
-            raise ValueError(f"theta (isotropic share of hardening) must lie in [0, 1], "
-                             f"got {self.theta!r}")
+        for name, bounds in (("sigma_Y (yield stress)", dict(positive=True)),
+                             ("H (hardening modulus)", dict(nonnegative=True)),
+                             ("theta (isotropic share of hardening)", dict(lo=0.0, hi=1.0))):
+            attr = name.split()[0]
+            object.__setattr__(self, attr, real(name, getattr(self, attr), **bounds))
 
     @property
     def lam(self) -> float:
@@ -144,9 +142,7 @@ class J2State:
 
     @classmethod
     def zeros(cls, n: int) -> "J2State":
-        if isinstance(n, bool) or int(n) != n or n < 0:
-            raise ValueError(f"n (number of points) must be a non-negative integer, got {n!r}")
-        n = int(n)
+        n = integer("n (number of points)", n, lo=0)
         return cls(np.zeros((n, 3, 3)), np.zeros(n), np.zeros((n, 3, 3)))
 
     def copy(self) -> "J2State":
@@ -180,9 +176,8 @@ def return_map(mat: J2Material, eps: np.ndarray, committed: J2State,
     """Radial return (4.38)-(4.41) from the committed state to the total strains ``eps``
     (N, 3, 3) (or (N, 2, 2), embedded as plane strain); a pure function of its inputs.
     ``tangent``: "algorithmic" (consistent), "continuum" (C^ep of Section 4.2.2) or None."""
-    if tangent is not None and tangent not in TANGENTS:
-        raise ValueError(f"tangent must be one of {TANGENTS} or None, got {tangent!r}")
-    eps = np.asarray(eps, dtype=float)
+    choice("tangent", tangent, TANGENTS + (None,))
+    eps = array("eps (total strains)", eps, finite=False)   # a NaN iterate: the solver's
     if eps.ndim == 3 and eps.shape[1:] == (2, 2):
         eps = embed_plane(eps)
     if eps.ndim != 3 or eps.shape[1:] != (3, 3):
@@ -215,8 +210,7 @@ def consistent_tangent(mat: J2Material, rm: ReturnMap, tangent: str = "algorithm
     (4.42)-(4.43) or "continuum") at ``points`` (indices; None = all N points), from its
     flow direction and trial norm; pointwise, so a subset gives the same numbers as the
     full set.  At an elastic point it is the elastic tangent C, bit for bit."""
-    if tangent not in TANGENTS:
-        raise ValueError(f"tangent must be one of {TANGENTS}, got {tangent!r}")
+    choice("tangent", tangent, TANGENTS)
     if rm.normal is None or rm.eta_norm is None:
         raise ValueError("rm must come from return_map (flow direction and trial norm)")
     sel = slice(None) if points is None else np.asarray(points, dtype=np.int64)

@@ -10,26 +10,18 @@ strain / plane stress reduction and Hooke's law (used by bem, fem and adaptivity
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
+
+from ..checks import choice, real
 
 PLANES = ("strain", "stress")
 
 
 def lame_constants(E: float, nu: float, plane: str = "strain") -> tuple[float, float]:
     """(lambda, mu) of the 2D model: plane strain, or plane stress with lambda*."""
-    for name, v in (("E (Young's modulus)", E), ("nu (Poisson ratio)", nu)):
-        if isinstance(v, (str, bytes, bool, np.bool_)):    # "0.3" is no silent 0.3
-            raise ValueError(f"{name} must be a number, got {v!r}")
-    E = float(E)
-    nu = float(nu)
-    if not (math.isfinite(E) and E > 0):
-        raise ValueError(f"E (Young's modulus) must be positive, got {E!r}")
-    if not (math.isfinite(nu) and -1.0 < nu < 0.5):
-        raise ValueError(f"nu (Poisson ratio) must lie in (-1, 0.5), got {nu!r}")
-    if plane not in PLANES:
-        raise ValueError(f"plane must be one of {PLANES}, got {plane!r}")
+    E = real("E (Young's modulus)", E, positive=True)
+    nu = real("nu (Poisson ratio)", nu, lo=-1.0, hi=0.5, lo_open=True, hi_open=True)
+    choice("plane", plane, PLANES)
     lam = E * nu / ((1.0 + nu) * (1.0 - 2.0 * nu))
     mu = E / (2.0 * (1.0 + nu))
     if plane == "stress":

@@ -34,7 +34,7 @@ import numpy as np
 
 from ..bodies.body import RigidObstacle, against_obstacle
 from ..constitutive.laws import OPEN, SLIP, STATE_NAMES, STICK  # noqa: F401  (re-exported)
-from ..constitutive.laws import positive
+from ..checks import InputTypeError, boolean, choice, integer, real
 from .result import ContactResult
 from .settings import ContactSettings
 from .two_body import TwoBodyContact
@@ -43,18 +43,10 @@ LAWS = ("tresca", "coulomb")
 FrictionResult = ContactResult
 
 
-def _count(name, value):
-    """An integer >= 1 (bools and non-integral values rejected)."""
-    if isinstance(value, bool) or not isinstance(value, (int, np.integer, float)) or \
-            not np.isfinite(value) or int(value) != value or int(value) < 1:
-        raise ValueError(f"{name} must be an integer >= 1, got {value!r}")
-    return int(value)
-
-
 def _law(friction, F, mu_f):
-    if not isinstance(friction, str) or friction.lower() not in LAWS:
-        raise ValueError(f"friction must be one of {LAWS}, got {friction!r}")
-    law = friction.lower()
+    if not isinstance(friction, str):
+        raise InputTypeError(f"friction must be one of {LAWS}, got {friction!r}")
+    law = choice("friction", friction, LAWS, fold_case=True)
     if law == "tresca":
         if F is None:
             raise ValueError("F (Tresca friction bound) is required for friction='tresca'")
@@ -65,7 +57,7 @@ def _law(friction, F, mu_f):
         raise ValueError("mu_f (Coulomb coefficient) is required for friction='coulomb'")
     if F is not None:
         raise ValueError("F is the Tresca bound; Coulomb takes mu_f")
-    return law, dict(mu_f=positive("mu_f", mu_f, allow_zero=True))
+    return law, dict(mu_f=real("mu_f", mu_f, nonnegative=True))
 
 
 def solve_friction(bem, eps_n: float, eps_t: float, gap, friction: str = "tresca",
@@ -88,19 +80,19 @@ def solve_friction(bem, eps_n: float, eps_t: float, gap, friction: str = "tresca
     initial : a converged result of the same body, law and points to continue from
         (U, slip, load and obstacle motion ramped from its final values)
     """
-    eps_n = positive("eps_n", eps_n)
-    eps_t = positive("eps_t", eps_t)
+    eps_n = real("eps_n", eps_n, positive=True)
+    eps_t = real("eps_t", eps_t, positive=True)
     law, bound = _law(friction, F, mu_f)
-    max_iter = _count("max_iter", max_iter)
-    load_steps = _count("load_steps", load_steps)
-    tol = positive("tol", tol)
-    if nq is not None:
-        nq = _count("nq", nq)
+    max_iter = integer("max_iter", max_iter, lo=1)
+    load_steps = integer("load_steps", load_steps, lo=1)
+    tol = real("tol", tol, positive=True)
+    nq = integer("nq", nq, lo=1, allow_none=True)
+    predictor = boolean("predictor", predictor)
     body, fixed, f = against_obstacle(bem, S, contact_label, dirichlet_label, load)
     pr = TwoBodyContact(body, RigidObstacle(gap, obstacle_slip), contact_label,
                         eps_n=eps_n, eps_t=eps_t, nq=nq, **bound)
     return pr.solve(f, fixed, None, np.arange(1, load_steps + 1) / load_steps,
                     ContactSettings(rtol=tol, max_iter=max_iter, line_search=True,
-                                    norm="max", predictor=bool(predictor),
+                                    norm="max", predictor=predictor,
                                     merit="energy" if law == "tresca" else "residual"),
                     initial=initial)

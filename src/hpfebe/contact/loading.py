@@ -15,6 +15,7 @@ import scipy.linalg as sla
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
+from ..checks import array
 from ..solvers import Iterate, SingularStep, SolverInfo
 from ..constitutive.laws import STATE_NAMES, updated_slip
 from .settings import ContactSettings
@@ -50,7 +51,8 @@ class LoadSteps:
                              "Tresca); Coulomb friction has none: use merit='residual'")
         self.pr, self.merit = pr, merit
         N = pr.ndofs
-        fixed = np.asarray([] if fixed_dofs is None else fixed_dofs, dtype=np.int64).ravel()
+        fixed = array("fixed_dofs", [] if fixed_dofs is None else fixed_dofs,
+                      dtype=np.int64).ravel()
         if fixed.size and (fixed.min() < 0 or fixed.max() >= N):
             raise ValueError(f"fixed_dofs must lie in [0, {N}), got range [{fixed.min()}, {fixed.max()}]")
         if np.unique(fixed).size != fixed.size:
@@ -90,24 +92,17 @@ class LoadSteps:
         if self.f_ext is None:
             f = np.zeros(N)
         elif callable(self.f_ext):
-            f = np.asarray(self.f_ext(lam), dtype=float)
+            f = array("f_ext", self.f_ext(lam), shape=(N,))
         else:
-            f = np.asarray(self.f_ext, dtype=float)
-            if f.shape == (N,):
-                f = self.f0 + lam * (f - self.f0)
-        if f.shape != (N,):
-            raise ValueError(f"f_ext must have shape ({N},), got {f.shape}")
-        if not np.all(np.isfinite(f)):
-            raise ValueError("f_ext must be finite")
+            f = array("f_ext", self.f_ext, shape=(N,))
+            f = self.f0 + lam * (f - self.f0)
         v = self.fixed_values
         if v is None:
             return f, np.zeros(fixed.size)
-        g = np.asarray(v(lam) if callable(v) else v, dtype=float)
+        g = array("fixed_values", v(lam) if callable(v) else v)
         if g.shape not in ((), (fixed.size,)):     # a scalar, or one value per fixed dof
             raise ValueError(f"fixed_values must be a scalar or have shape ({fixed.size},) "
-                             f"(one per fixed dof), got {g.shape}")
-        if not np.all(np.isfinite(g)):
-            raise ValueError("fixed_values must be finite")
+                             f"(one per fixed dof), got shape {g.shape}")
         g = np.broadcast_to(g, (fixed.size,)).astype(float)
         return f, (g if callable(v) else lam * g)
 

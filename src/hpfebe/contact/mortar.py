@@ -40,6 +40,7 @@ import numpy as np
 
 from ..bem.lame import LameBEM
 from ..bodies.condensed import CondensedBody
+from ..checks import InputTypeError, array, instance, real
 from ..coupling.mortar import MortarProjection
 from ..geometry import BoundaryMesh
 from ..quadrature import gauss_lobatto
@@ -124,6 +125,67 @@ def condensed_body(bem, dirichlet, contact, name: str) -> CondensedBody:
     return CondensedBody(bem.S_hat, fixed, vals, contact)
 
 
+def obstacle(Q, nc: int) -> np.ndarray:
+    """The obstacle Q of step 4: an interleaved vector on the 2 nc contact dofs of body 1
+    (a clear error for one of another length, e.g. a traction on body 2's dofs)."""
+    return array("Q", Q, shape=(2 * nc,), finite=False)
+
+
+def nodal_bound(bound, nc: int):
+    """A nodal friction bound (nc,) >= 0 replacing F (a scalar: the same at every
+    node), or None."""
+    if bound is None:
+        return None
+    b = array("bound", np.broadcast_to(bound, (nc,)) if np.ndim(bound) == 0 else bound,
+              shape=(nc,), finite=False)
+    if np.any(b < 0):
+        raise ValueError(f"bound must be >= 0, got {b.min()!r}")
+    return b
+
+
+def rho_hint(info: SolverInfo, rho: float, rho_crit: float) -> None:
+    """Name the cause of a diverged Uzawa iteration whose step exceeds rho_crit."""
+    if rho >= rho_crit:
+        info.reason += (f" (the step rho = {rho:.4g} exceeds rho_crit = {rho_crit:.4g} of "
+                        "Theorem 3.1.8 for body 1 with no node in contact, e.g. a stamp "
+                        "lifted off: take a smaller rho or UzawaSettings(relative=True))")
+
+
+def contact_normals(normal, outward, points) -> np.ndarray:
+    """The normals of the contact nodes: ``outward`` (:func:`default_normals`) if
+    ``normal`` is None, else normal(points), checked (:func:`check_outward`)."""
+    if normal is None:
+        return outward
+    if not callable(normal):
+        raise InputTypeError(f"normal must be a callable (m, 2) points -> (m, 2) normals, got "
+                             f"{normal!r}")
+    nrm = array("normal(x)", normal(points), shape=outward.shape)
+    check_outward(nrm, outward, points)
+    return nrm
+
+
+def check_outward(normals, outward, points) -> None:
+    """ValueError unless every given normal of Gamma^1_C is nonzero and points out of
+    body 1, n_j . n_mesh_j > 0 (``outward``: the element normals of the counter-clockwise
+    boundary mesh, :func:`default_normals`): the constraint U_n - Q_n <= g of
+    Algorithm 4.3 and the gap along n assume the outward normal; an inward one turns
+    the obstacle round (measured: converged with 0.09 of penetration)."""
+    size = np.linalg.norm(normals, axis=1)
+    if np.any(size == 0):
+        k = int(np.flatnonzero(size == 0)[0])
+        raise ValueError(f"normal(x) must be nonzero, got (0, 0) at the contact node "
+                         f"x = {tuple(np.round(points[k], 12))}")
+    cos = np.sum(normals * outward, axis=1) / (size * np.linalg.norm(outward, axis=1))
+    bad = np.flatnonzero(~(cos > 0))
+    if bad.size:
+        k = int(bad[0])
+        raise ValueError(
+            f"normal(x) must be the outward normal of body 1 (n . n_mesh > 0, pointing "
+            f"towards body 2), got one pointing into body 1 at {bad.size} of {len(cos)} "
+            f"contact nodes (first at x = {tuple(np.round(points[k], 12))}: n = "
+            f"{tuple(normals[k])}, n . n_mesh = {cos[k]:.3g}); reverse its sign")
+
+
 def node_frame(normals):
     """The frame (n, t = (-n_y, n_x)) at the contact nodes of the (unnormalised)
     ``normals`` and the rotation R of an interleaved vector u_c to (u_n, u_t)."""
@@ -171,11 +233,6 @@ class MortarSolution:
     extra: dict = field(default_factory=dict)
 
 
-def _check_pos(name, v):
-    if not (np.isfinite(v) and v > 0.0):
-        raise ValueError(f"{name} must be positive, got {v!r}")
-
-
 def traction_state(pr, P, info, friction: str, mu_f: float) -> MortarSolution:
     """The solution of the nodal contact traction P of :meth:`MortarContact.global_uzawa`
     or :meth:`MortarContact.semismooth_newton`: displacements of the two Neumann
@@ -213,9 +270,9 @@ class MortarContact:
     def __init__(self, bem1: LameBEM, bem2: LameBEM, dirichlet1, dirichlet2, F: float,
                  normal=None, label: str = "C", axis=(1.0, 0.0), test_space: str = "full",
                  gap=None):
-        if not np.isfinite(F) or F < 0:
-            raise ValueError(f"F must be >= 0, got {F!r}")
-        self.bem1, self.bem2, self.F = bem1, bem2, float(F)
+        instance("bem1", bem1, LameBEM, "a LameBEM (a Lame body)")
+        instance("bem2", bem2, LameBEM, "a LameBEM (a Lame body)")
+        self.bem1, self.bem2, self.F = bem1, bem2, real("F", F, nonnegative=True)
         self.mortar = MortarProjection(bem1.mesh, bem2.mesh, label, label, axis,
                                        bem1.V_space, bem2.V_space, test_space)
         m = self.mortar
@@ -229,10 +286,8 @@ class MortarContact:
         nc = m.dofs1.size
         self.nc = nc
         self.points = node_points(bem1, m.dofs1)
-        nrm = default_normals(bem1.V_space, m.dofs1, label) if normal is None else \
-            np.asarray(normal(self.points), dtype=float)
-        if nrm.shape != (nc, 2):
-            raise ValueError(f"normal must return ({nc}, 2) normals, got {nrm.shape}")
+        nrm = contact_normals(normal, default_normals(bem1.V_space, m.dofs1, label),
+                              self.points)
         self._normal_fn = normal
         self._gap_fn = gap
         self._set_frame(nrm)
@@ -304,7 +359,7 @@ class MortarContact:
     def rho_step(self, rho: float, relative: bool) -> float:
         """The Uzawa step used: ``rho`` itself, or rho * rho_crit / 2 when ``relative``
         (rho = 1 is then the step with the fastest contraction of the stiffest mode)."""
-        _check_pos("rho", rho)
+        rho = real("rho", rho, positive=True)
         if not relative or self.F == 0.0:
             return float(rho)
         return float(rho) * 0.5 * self.rho_crit
@@ -326,7 +381,7 @@ class MortarContact:
         """Algorithm 4.4 step 2: frictionless contact of body 1 against the obstacle Q
         with the friction load F w lambda (``bound``: a nodal friction bound replacing F,
         e.g. mu_f p_n), by projected CG.  Returns (x, info)."""
-        Fw, upper = self._qp_data(Q, bound)
+        Fw, upper = self._qp_data(obstacle(Q, self.nc), nodal_bound(bound, self.nc))
         qp = self._bound_qp()
         rhs = friction_rhs(qp.b, Fw, np.asarray(lam, dtype=float))
         return qp.solve(rhs, upper, x0, tol)
@@ -360,16 +415,19 @@ class MortarContact:
         info); x = (U_n, U_t) at the contact nodes for the returned lambda.  ``bound``:
         nodal friction bound s_j replacing F (lambda_j += rho s_j (U_t - Q_t)_j).  The QP
         data fixed by Q and the bound are built once per call."""
-        uz = settings
+        uz = instance("settings", settings, UzawaSettings)
+        Q, bound = obstacle(Q, self.nc), nodal_bound(bound, self.nc)
         rho = self.rho_step(uz.rho, uz.relative) if bound is None else \
             self._rho_bound(uz.rho, uz.relative, bound)
         F = self.F if bound is None else np.asarray(bound, dtype=float)
         _, Qt = self.frame(Q)
-        lam0 = np.zeros(self.nc) if lam0 is None else np.asarray(lam0, dtype=float)
-        if lam0.shape != (self.nc,):
-            raise ValueError(f"lam0 must have shape ({self.nc},), got {lam0.shape}")
+        lam0 = np.zeros(self.nc) if lam0 is None else array("lam0", lam0, shape=(self.nc,),
+                                                               finite=False)
         Fw, upper = self._qp_data(Q, bound)
-        return tresca_uzawa(self._bound_qp(), Fw, rho * F, Qt, upper, lam0, x0, uz)
+        x, lam, info = tresca_uzawa(self._bound_qp(), Fw, rho * F, Qt, upper, lam0, x0, uz)
+        if not info.converged and info.reason.startswith("diverged") and bound is None:
+            rho_hint(info, rho, self.rho_crit)
+        return x, lam, info
 
     # ---------------------------------------------------------------- DtN
     def dtn(self, settings: DtNSettings, friction: str = "tresca") -> MortarSolution:

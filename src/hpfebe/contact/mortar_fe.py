@@ -13,8 +13,8 @@ the reaction of step 5, the frame, the gap and the Lobatto weights are inherited
 unchanged, and the DtN iteration is the one of :func:`hpfebe.solvers.dtn.dtn`.  The traces of the
 Q1 bodies on their boundaries are the continuous P1 spaces of
 :class:`~hpfebe.spaces.ContinuousSpace` on a :class:`~hpfebe.geometry.BoundaryMesh`
-through the FE boundary vertices (:func:`fe_trace_mesh`), and the data transfer is the
-mortar projection (4.87) of :class:`hpfebe.coupling.mortar.MortarProjection`.
+through the FE boundary vertices (:func:`hpfebe.coupling.mortar.fe_trace_mesh`), and the
+data transfer is the mortar projection (4.87) of :class:`hpfebe.coupling.mortar.MortarProjection`.
 
 What differs from the BEM version is step 2: the Neumann problem of body 2 is the
 elastoplastic one (Remark 4.3.5: the nonlinearities are separated),
@@ -47,46 +47,14 @@ import scipy.sparse.linalg as spla
 from scipy.linalg import lapack
 
 from ..bodies.condensed import CondensedBody
+from ..checks import instance, integer, real
 from ..constitutive.j2 import dev, tensor_norm
-from ..coupling.mortar import MortarProjection
+from ..coupling.mortar import SIDES, MortarProjection, fe_trace_mesh
 from ..fem.elasticity import ElasticBody
 from ..fem.plastic_body import DisplacementSteps, ElastoPlasticFE
-from ..geometry import BoundaryMesh
 from ..solvers import Iterate, SingularStep, SolverInfo, newton
 from ..solvers.dtn import DtNSettings, DtNState, dtn, transfer_maps
-from ..spaces import ContinuousSpace
-from .mortar import MortarContact, MortarSolution, _check_pos, ray_gap
-
-SIDES = ("bottom", "right", "top", "left")
-
-
-# --------------------------------------------------------------------------- traces
-def fe_trace_mesh(mesh, contact: str):
-    """The boundary of a rectangle FE mesh (labelled "bottom", "right", "top", "left",
-    :func:`hpfebe.fem.elasticity.rectangle_mesh`) as a P1 :class:`BoundaryMesh` through
-    its boundary vertices, the side ``contact`` labelled "C", and the FE vertex of every
-    dof of the :class:`ContinuousSpace` on it.  Returns (boundary mesh, space, vertex)."""
-    if contact not in SIDES:
-        raise ValueError(f"contact must be one of {SIDES}, got {contact!r}")
-    b = mesh.boundaries or {}
-    if any(s not in b for s in SIDES):
-        raise ValueError(f"mesh must have the boundaries {SIDES}, got {sorted(b)}")
-    lo, hi = mesh.p.min(axis=1), mesh.p.max(axis=1)
-    corners = [(lo[0], lo[1]), (hi[0], lo[1]), (hi[0], hi[1]), (lo[0], hi[1])]
-    n = [len(b[s]) for s in SIDES]
-    labels = ["C" if s == contact else s for s in SIDES]
-    bm = BoundaryMesh.polygon(corners, n=n, labels=labels, p=1)
-    space = ContinuousSpace(bm)
-    used = np.unique(bm.elements)                     # vertex dofs in ContinuousSpace order
-    pts = bm.nodes[used]
-    d = np.linalg.norm(pts[:, None, :] - mesh.p.T[None, :, :], axis=2)
-    vertex = np.argmin(d, axis=1)
-    scale = float(np.max(hi - lo))
-    if d[np.arange(len(pts)), vertex].max() > 1e-9 * scale:
-        raise ValueError("mesh must be a uniform rectangle mesh (its boundary vertices "
-                         "equally spaced on every side)")
-    return bm, space, vertex
-
+from .mortar import MortarContact, MortarSolution, ray_gap
 
 def _vector_dofs(body, vertex) -> np.ndarray:
     """Interleaved FE dofs (x, y of each vertex in turn) of the vertices ``vertex``."""
@@ -201,19 +169,16 @@ class _BandSteps(DisplacementSteps):
 @dataclass(frozen=True)
 class NeumannSettings:
     """Newton for step 2 of Algorithm 4.3 on the elastoplastic body 2, (4.88): stop at
-    ||R||_inf <= ``tol`` x (force scale + :attr:`FEMortarContact.force_floor`), at most
+    ||R||_inf <= ``tol`` x (force scale + :attr:`FEMortarContact.newton_floor`), at most
     ``max_iter`` iterations."""
 
     tol: float = 1e-8
     max_iter: int = 30
 
     def __post_init__(self):
-        if not (np.isfinite(self.tol) and self.tol > 0):
-            raise ValueError(f"newton tol must be positive, got {self.tol!r}")
-        if isinstance(self.max_iter, bool) or int(self.max_iter) != self.max_iter or \
-                self.max_iter < 1:
-            raise ValueError(f"newton max_iter must be a positive integer, got "
-                             f"{self.max_iter!r}")
+        object.__setattr__(self, "tol", real("newton tol", self.tol, positive=True))
+        object.__setattr__(self, "max_iter", integer("newton max_iter", self.max_iter,
+                                                     lo=1))
 
 
 class FEMortarContact(MortarContact):
@@ -232,17 +197,17 @@ class FEMortarContact(MortarContact):
 
     def __init__(self, stamp: ElasticBody, work: ElastoPlasticFE, dirichlet1, dirichlet2,
                  F: float, contact1: str = "bottom", contact2: str = "top"):
-        if not isinstance(stamp, ElasticBody):
-            raise ValueError(f"stamp must be an ElasticBody, got {type(stamp).__name__}")
-        if not isinstance(work, ElastoPlasticFE):
-            raise ValueError(f"work must be an ElastoPlasticFE, got {type(work).__name__}")
-        if not np.isfinite(F) or F < 0:
-            raise ValueError(f"F must be >= 0, got {F!r}")
-        self.stamp, self.work, self.F = stamp, work, float(F)
+        instance("stamp", stamp, ElasticBody)
+        instance("work", work, ElastoPlasticFE)
+        self.stamp, self.work, self.F = stamp, work, real("F", F, nonnegative=True)
         self.mesh1, space1, vert1 = fe_trace_mesh(stamp.mesh, contact1)
         self.mesh2, space2, vert2 = fe_trace_mesh(work.mesh, contact2)
-        self.mortar = m = MortarProjection(self.mesh1, self.mesh2, "C", "C", (1.0, 0.0),
-                                           space1, space2, "full")
+        try:
+            self.mortar = m = MortarProjection(self.mesh1, self.mesh2, "C", "C",
+                                               (1.0, 0.0), space1, space2, "full")
+        except ValueError as err:
+            raise ValueError(f"stamp, work: the stamp's side {contact1!r} must lie on the "
+                             f"work piece's side {contact2!r} along x: {err}") from None
         self.c1 = _vector_dofs(stamp, vert1[m.dofs1])    # FE dofs of body 1 on Gamma^1_C
         self.c2 = _vector_dofs(work.elastic, vert2[m.dofs2])  # ... of body 2 on Gamma^2_C
         # the tangential component of an interleaved vector on Gamma^2_C (a straight side)
@@ -264,6 +229,9 @@ class FEMortarContact(MortarContact):
         self.w = self._lobatto_weights(self.mesh1, space1, m.dofs1, "C")
         # body 2's Neumann problem (4.88): prescribed sides, load on Gamma^2_C
         self.steps2 = _BandSteps(work, self.fixed2, self.values2, extrapolate=False)
+        # the data's force scale: body 2's prescribed displacement, the other dofs held
+        K2D = self.work.K.tocsc()[:, self.fixed2]
+        self.data_force2 = float(np.abs(K2D @ self.values2).max(initial=0.0))
         # the mortar projection as a matrix on interleaved vectors (2 nc x 2 n2c)
         Pi = spla.splu(sp.csc_matrix(m.D)).solve(m.B.toarray())     # D^-1 B, (4.87)
         self.Pi = np.kron(Pi, np.eye(2))
@@ -292,14 +260,14 @@ class FEMortarContact(MortarContact):
         1 transferred by the adjoint mortar projection), U2 prescribed on its Dirichlet
         side; one step from the committed history, Newton from ``u0`` (default: the
         elastic solution, :meth:`elastic_start`) until ||R||_inf <= tol x (force scale +
-        :attr:`force_floor`).  Returns (U2 on all FE dofs, SolverInfo)."""
+        :attr:`newton_floor`).  Returns (U2 on all FE dofs, SolverInfo)."""
         st = self.steps2
         f = np.zeros(self.work.ndofs)
         f[self.c2] = -np.asarray(P, dtype=float)
         st.f_ext = f
         x0 = self.elastic_start(f) if u0 is None else np.asarray(u0, dtype=float)
         it, info = newton(st.problem(1.0), st.start(x0, 1.0), tol, max_iter,
-                          atol=tol * self.force_floor, norm=np.inf)
+                          atol=tol * self.newton_floor, norm=np.inf)
         return it.x, info
 
     @property
@@ -315,6 +283,14 @@ class FEMortarContact(MortarContact):
         f = self.work.mesh.facets
         h = float(np.linalg.norm(p[:, f[0]] - p[:, f[1]], axis=0).min())
         return self.work.material.stress_floor * h
+
+    @property
+    def newton_floor(self) -> float:
+        """The absolute floor of the Newton tests (times their tolerance):
+        :attr:`force_floor` capped by ``data_force2`` (the forces of body 2's prescribed
+        displacement), scale-free as the displacement goes to 0 (the floor alone
+        accepted the rigid start of a lift of 1e-14); on Section 4.4 it is force_floor."""
+        return min(self.force_floor, self.data_force2)
 
     def elastic_start(self, f_ext) -> np.ndarray:
         """The linear elastic response of body 2 to the prescribed values and the load
@@ -368,7 +344,7 @@ class FEMortarContact(MortarContact):
         ||(pi U2)_n||_inf (``info.backward_error``), and the work piece's equilibrium
         residual under P (:meth:`kkt_residual`, ``equilibrium2``) is <= ``coupling_tol``.
 
-        ``newton``: step 2 to ||R||_inf <= tol x (force scale + :attr:`force_floor`);
+        ``newton``: step 2 to ||R||_inf <= tol x (force scale + :attr:`newton_floor`);
         the thesis's TOL_N = 1e-4 in this norm leaves the Neumann solutions too inexact
         for TOL_DtN = 1e-6 (the DtN increments stagnate at ~4e-5), hence the default
         1e-8 (Newton converges quadratically: one more iteration).  ``F``: a given
@@ -385,9 +361,8 @@ class FEMortarContact(MortarContact):
         body 2 ``force2`` and the work piece's stress fields (:meth:`work_fields`)."""
         bound = None
         if F is not None:
-            if not (np.isfinite(F) and F >= 0):
-                raise ValueError(f"F must be >= 0, got {F!r}")
-            bound = np.full(self.nc, float(F))
+            bound = np.full(self.nc, real("F", F, nonnegative=True))
+        coupling_tol = real("coupling_tol", coupling_tol, positive=True)
         norms = []
 
         def iteration(st: DtNState) -> SolverInfo:
@@ -429,18 +404,14 @@ class FEMortarContact(MortarContact):
             u2, ninfo = self.neumann(load2(P), u2, newton.tol, newton.max_iter)
             if not ninfo.converged:
                 info.converged, info.reason = False, f"final Neumann solve: {ninfo.reason}"
-        # backward error of the transfer: at a fixed point Q_n = (pi U2)_n (step 3; the
-        # tangential Q_t enters only through the slip direction where the stamp slides);
-        # a P that stops changing because the stamp has lost contact (P = 0 twice) is no
-        # solution
-        qn, pn = self.frame(st.Q)[0], self.frame(m.project(u2[self.c2]))[0]
-        info.backward_error = float(np.abs(qn - pn).max() / max(np.abs(pn).max(), 1e-300))
+        x = st.x if st.x is not None else np.zeros(2 * self.nc)
+        info.backward_error = contact_backward_error(self, x, st.R1, m.project(u2[self.c2]))
         if info.converged and info.backward_error > coupling_tol:
             info.converged = False
-            info.reason = (f"no solution: P stopped changing but the obstacle Q_n differs "
-                           f"from (pi U2)_n by {info.backward_error:.1e} (relative) > "
-                           f"coupling_tol = {coupling_tol:g}")
-        x = st.x if st.x is not None else np.zeros(2 * self.nc)
+            info.reason = (f"no solution: P stopped changing but the stamp's contact "
+                           f"conditions against the work piece's (pi U2)_n are violated "
+                           f"by {info.backward_error:.1e} (relative) > coupling_tol = "
+                           f"{coupling_tol:g}")
         u1 = self.body1.expand(self.R.T @ x)
         sol = MortarSolution(u1[self.c1], u2[self.c2], st.lam, st.Q, P, x, info,
                              extra=dict(u1=u1, u2=u2, force2=load2(P),
@@ -460,16 +431,16 @@ class FEMortarContact(MortarContact):
         """(Beyond the thesis) the discrete problem of :meth:`dtn` solved at once by a
         semismooth Newton method (:func:`hpfebe.solvers.newton`, line search on
         1/2 |F|^2) on the KKT system :class:`MonolithicKKT`.  c: the complementarity
-        constant (default the mean diagonal of A1).  Stop: ||F||_inf <= tol x force
-        scale."""
+        constant (default the mean diagonal of A1).  Stop: ||F||_inf <= tol x (force
+        scale + min(force_floor, the data's force scale ``kkt.data_scale``))."""
+        tol, max_iter = real("tol", tol, positive=True), integer("max_iter", max_iter, lo=1)
         st2 = self.steps2
         st2.f_ext = np.zeros(self.work.ndofs)
         st2.problem(1.0)
-        c = float(np.mean(np.diag(self.body1.A))) if c is None else float(c)
-        _check_pos("c", c)
+        c = real("c", np.mean(np.diag(self.body1.A)) if c is None else c, positive=True)
         kkt = MonolithicKKT(self, c)
-        it, info = newton(kkt, kkt.start(), tol, max_iter, atol=tol * self.force_floor,
-                          norm=np.inf)
+        it, info = newton(kkt, kkt.start(), tol, max_iter,
+                          atol=tol * min(self.force_floor, kkt.data_scale), norm=np.inf)
         u1c, u2, y = kkt.split(it.x)
         info.counts = dict(c=c, unknowns=int(it.x.size))
         nc, bound = self.nc, self.F * self.w
@@ -505,9 +476,28 @@ class FEMortarContact(MortarContact):
         r = f.copy()
         r[self.c2] += sol.extra.get("force2", sol.P)
         free = self.steps2.free
-        out = dict(equilibrium2=float(np.abs(r[free]).max() / max(np.abs(f).max(), 1e-300)))
+        scale = max(float(np.abs(f).max()), float(np.abs(r - f).max())) + self.newton_floor
+        out = dict(equilibrium2=float(np.abs(r[free]).max() / max(scale, 1e-300)))
         out.update(self.tresca_residual(sol))
         return out
+
+
+def contact_backward_error(pr: "FEMortarContact", x, R1, Q_true) -> float:
+    """Backward error of the transfer (step 3) of :meth:`FEMortarContact.dtn`: the
+    normal contact conditions of the stamp's x = (U_n, U_t) and nodal force
+    y_n = -R1_n >= 0 against the returned work piece's obstacle Q* = pi U2 (not the
+    damped Q of the last step 3), max_j |min(y_j / c, g_j + Q*_n,j - U_n,j)| / max |Q*_n|
+    (c of :meth:`FEMortarContact.monolithic`; nodes without a gap skipped): zero iff
+    y >= 0, slack >= 0, y x slack = 0.  In contact (y_j / c above the mismatch) it is
+    |Q_n - Q*_n|, the former measure, which called the P = 0 of a correct lift-off 'no
+    solution'.  Q_t enters only through the slip direction where the stamp slides."""
+    qs = pr.frame(Q_true)[0]
+    y = np.zeros(pr.nc) if R1 is None else -pr.frame(R1)[0]
+    c = float(np.mean(np.diag(pr.body1.A)))
+    closed = np.isfinite(pr.gap)
+    slack = np.where(closed, pr.gap, 0.0) + qs - x[:pr.nc]
+    r = np.where(closed, np.minimum(y / c, slack), 0.0)
+    return float(np.abs(r).max(initial=0.0) / max(np.abs(qs).max(initial=0.0), 1e-300))
 
 
 # --------------------------------------------------------------------------- monolithic
@@ -542,6 +532,11 @@ class MonolithicKKT:
         self.gap = np.where(self.closed, pr.gap, 0.0)
         self.bound = pr.F * pr.w
         self.u2_0 = pr.elastic_start(pr.steps2.f_ext)
+        # the force scale of the data (:attr:`FEMortarContact.newton_floor`): body 2's
+        # prescribed displacement, body 1's load, an initial overlap times c
+        over = np.where(self.closed, np.maximum(0.0, -self.gap), 0.0)
+        self.data_scale = max(pr.data_force2, float(np.abs(self.b1).max(initial=0.0)),
+                              c * float(over.max(initial=0.0)))
         self.sl = (slice(0, n1), slice(n1, n1 + nf), slice(n1 + nf, 2 * n1 + nf))
 
     def start(self) -> np.ndarray:
@@ -592,5 +587,4 @@ class MonolithicKKT:
         return -2.0 * it.merit
 
 
-__all__ = ["FEMortarContact", "MonolithicKKT", "NeumannSettings", "fe_trace_mesh",
-           "spd_band_solve"]
+__all__ = ["FEMortarContact", "MonolithicKKT", "NeumannSettings", "spd_band_solve"]

@@ -34,7 +34,7 @@ import numpy as np
 
 from ..solvers import SolverInfo
 from ..bodies.body import RigidObstacle, against_obstacle
-from ..constitutive.laws import positive
+from ..checks import boolean, integer, real
 from .settings import ContactSettings
 from .two_body import TwoBodyContact
 
@@ -90,10 +90,10 @@ def solve_penalty(bem, eps: float, gap, load=None, contact_label: str = "C",
 
     A gap that is never closed gives the zero-contact solution (reason "no contact").
     """
-    eps = positive("eps (penalty parameter)", eps)
-    tol = positive("tol", tol)
-    if isinstance(max_iter, bool) or int(max_iter) < 1:
-        raise ValueError(f"max_iter must be >= 1, got {max_iter!r}")
+    eps = real("eps (penalty parameter)", eps, positive=True)
+    tol = real("tol", tol, positive=True)
+    max_iter = integer("max_iter", max_iter, lo=1)
+    keep_jacobian = boolean("keep_jacobian", keep_jacobian)
     body, fixed, f = against_obstacle(bem, S, contact_label, dirichlet_label, load)
     pr = TwoBodyContact(body, RigidObstacle(gap), contact_label, eps_n=eps,
                         quadrature="exact")

@@ -10,7 +10,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..constitutive.laws import positive
+from ..checks import boolean, choice, integer, real
 from ..solvers import LineSearch
 
 #: merit functions of the line search: ||R||_2, or the potential of a potential law
@@ -25,11 +25,6 @@ LU_ORDERINGS = ("COLAMD", "MMD_AT_PLUS_A")
 #: problem and the contact terms by the Sherman-Morrison-Woodbury formula (linear bodies)
 LINEAR_SOLVERS = ("lu", "woodbury")
 NORMS = ("l2", "max")
-
-
-def _count(name: str, value, least: int) -> None:
-    if isinstance(value, bool) or int(value) != value or value < least:
-        raise ValueError(f"{name} must be an integer >= {least}, got {value!r}")
 
 
 @dataclass(frozen=True)
@@ -71,23 +66,24 @@ class ContactSettings:
     linear_solver: str = "lu"
 
     def __post_init__(self):
+        # every field checked by hpfebe.checks and stored as a Python float/int/bool
+        # ('no' is not True, 1.5 is not a count, np.float32 is a number)
+        def put(name, value):
+            object.__setattr__(self, name, value)
+
         for name in ("rtol", "atol"):
-            positive(name, getattr(self, name), allow_zero=True)
+            put(name, real(name, getattr(self, name), nonnegative=True))
         if self.rtol == 0 and self.atol == 0:
             raise ValueError("rtol and atol must not both be zero")
-        _count("max_iter", self.max_iter, 1)
-        _count("max_cuts", self.max_cuts, 0)
-        if not (np.isfinite(self.min_step) and 0 < self.min_step <= 1):
-            raise ValueError(f"min_step must lie in (0, 1], got {self.min_step!r}")
+        put("max_iter", integer("max_iter", self.max_iter, lo=1))
+        put("max_cuts", integer("max_cuts", self.max_cuts, lo=0))
+        put("min_step", real("min_step", self.min_step, lo=0.0, hi=1.0, lo_open=True))
         for name, allowed in (("norm", NORMS), ("merit", MERITS),
                               ("lu_ordering", LU_ORDERINGS),
                               ("linear_solver", LINEAR_SOLVERS)):
-            if getattr(self, name) not in allowed:
-                raise ValueError(f"{name} must be one of {allowed}, got "
-                                 f"{getattr(self, name)!r}")
+            choice(name, getattr(self, name), allowed)
         for name in ("line_search", "predictor", "roundoff_stop"):
-            if not isinstance(getattr(self, name), (bool, np.bool_)):
-                raise ValueError(f"{name} must be a bool, got {getattr(self, name)!r}")
+            put(name, boolean(name, getattr(self, name)))
 
     def line_search_rule(self) -> LineSearch:
         """The Armijo rule of :func:`hpfebe.solvers.newton` for ``merit``: on the energy

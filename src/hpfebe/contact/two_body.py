@@ -114,7 +114,8 @@ import scipy.sparse as sp
 
 from ..solvers import Iterate, SolverInfo, load_path
 from ..bodies.body import as_body, pointwise
-from ..constitutive.laws import penalty_friction, positive, tresca_energy
+from ..checks import array, boolean, choice, instance, integer, real
+from ..constitutive.laws import penalty_friction, tresca_energy
 from .loading import LoadSteps
 from .points import rigid_points, trace_maps, two_body_points
 from .positive_part import ExactPositivePart
@@ -194,15 +195,13 @@ class TwoBodyContact:
         self.slave, self.master = slave, master
         if self.bodies["slave"].kind == "rigid":
             raise ValueError("slave must be a deformable body (the obstacle is the master)")
-        self.eps_n = positive("eps_n", eps_n)
-        self.eps_t = positive("eps_t", eps_t)
-        self.mu_f = positive("mu_f", mu_f, allow_zero=True)
+        self.eps_n = real("eps_n", eps_n, positive=True)
+        self.eps_t = real("eps_t", eps_t, positive=True)
+        self.mu_f = real("mu_f", mu_f, nonnegative=True)
         if F is not None and self.mu_f > 0:
             raise ValueError("give mu_f (Coulomb) or F (Tresca), not both")
-        if nq is not None and (isinstance(nq, bool) or int(nq) != nq or nq < 1):
-            raise ValueError(f"nq must be a positive integer, got {nq!r}")
-        self.nq = None if nq is None else int(nq)
-        self.split = bool(split)
+        self.nq = integer("nq", nq, lo=1, allow_none=True)
+        self.split = boolean("split", split)
         sb, mb = self.bodies["slave"], self.bodies["master"]
         self.two_pass = self._two_pass(two_pass, mb, quadrature)
         self.offset = sb.ndofs
@@ -225,8 +224,7 @@ class TwoBodyContact:
     def _two_pass(two_pass, master, quadrature) -> bool:
         """Validated ``two_pass``: a bool, only for a deformable master and the fixed
         Gauss points (the exact positive part is a one-body quadrature)."""
-        if not isinstance(two_pass, (bool, np.bool_)):
-            raise ValueError(f"two_pass must be a bool, got {two_pass!r}")
+        two_pass = boolean("two_pass", two_pass)
         if two_pass and master.kind == "rigid":
             raise ValueError("two_pass needs a deformable master (a rigid obstacle has no "
                              "contact points of its own)")
@@ -235,8 +233,7 @@ class TwoBodyContact:
         return bool(two_pass)
 
     def _exact_quadrature(self, quadrature: str, slave_boundary):
-        if quadrature not in QUADRATURES:
-            raise ValueError(f"quadrature must be one of {QUADRATURES}, got {quadrature!r}")
+        choice("quadrature", quadrature, QUADRATURES)
         if quadrature == "gauss":
             return None
         sb, mb = self.bodies["slave"], self.bodies["master"]
@@ -427,13 +424,9 @@ class TwoBodyContact:
         converged state at most ``settings.max_cuts`` times.  ``initial``: a converged
         result of this problem to continue from (U, slip, load and obstacle motion
         ramped from its final values)."""
-        if not isinstance(settings, ContactSettings):
-            raise ValueError(f"settings must be a ContactSettings, got {settings!r}")
+        instance("settings", settings, ContactSettings)
         steps = LoadSteps(self, f_ext, fixed_dofs, fixed_values, settings, initial)
-        lf = np.asarray(load_factors, dtype=float).ravel()
-        if lf.size == 0 or not np.all(np.isfinite(lf)):
-            raise ValueError(f"load_factors must be a non-empty finite sequence, got "
-                             f"{load_factors!r}")
+        lf = array("load_factors", load_factors, ndim=1, min_size=1)
         it, info = load_path(steps, lf, steps.x0, max_cuts=settings.max_cuts, lam0=0.0,
                              **steps.newton_options())
         return self.result(it, info, steps)

@@ -37,6 +37,7 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 from skfem import Basis, ElementQuad1, ElementTriP1, ElementVector, MeshQuad, MeshTri
 
+from ..checks import array, boolean, choice, finite, instance
 from ..solvers import Iterate, SingularStep
 from .elasticity import ElasticBody
 from .meshes import FEDomain
@@ -91,12 +92,9 @@ class ElastoPlasticFE:
                  tangent: str = "algorithmic"):
         if isinstance(mesh, FEDomain):
             mesh = mesh.mesh
-        if not isinstance(material, J2Material):
-            raise ValueError(f"material must be a J2Material, got {type(material).__name__}")
-        if formulation not in FORMULATIONS:
-            raise ValueError(f"formulation must be one of {FORMULATIONS}, got {formulation!r}")
-        if tangent not in TANGENTS:
-            raise ValueError(f"tangent must be one of {TANGENTS}, got {tangent!r}")
+        instance("material", material, J2Material)
+        choice("formulation", formulation, FORMULATIONS)
+        choice("tangent", tangent, TANGENTS)
         if isinstance(mesh, MeshQuad):
             elem, order = ElementQuad1(), 2
         elif isinstance(mesh, MeshTri):
@@ -149,9 +147,7 @@ class ElastoPlasticFE:
 
     def strain(self, u: np.ndarray) -> np.ndarray:
         """(nel * nq, 3, 3) (B-bar) strain of the dof vector u at the quadrature points."""
-        u = np.asarray(u, dtype=float)
-        if u.shape != (self.ndofs,):
-            raise ValueError(f"u must have shape ({self.ndofs},), got {u.shape}")
+        u = array("u", u, shape=(self.ndofs,), finite=False)   # NaN: the solver's to judge
         ue = np.ascontiguousarray(u[self.element_dofs].T)           # (nel, nloc)
         eps = _strain_kernel(self.B, ue)
         return eps.reshape(-1, 3, 3)
@@ -232,8 +228,12 @@ class ElastoPlasticFE:
         return f, lambda: self.tangent_matrix(rm)
 
     def commit(self, u: np.ndarray) -> None:
-        """The state at u becomes the committed history (after a converged load step)."""
+        """The state at u becomes the committed history (after a converged load step);
+        ValueError if u or the state at u is not finite (NaN is never history)."""
+        finite("u (the displacement committed as history)", u)
         _, rm = self.state_at(u)
+        finite("the state at u (eps_p, alpha, beta, sigma)", rm.state.eps_p,
+               rm.state.alpha, rm.state.beta, rm.sigma)
         self.committed = rm.state.copy()
         self.sigma = rm.sigma.copy()
         self._cache = None
@@ -304,17 +304,19 @@ class DisplacementSteps:
 
     def __init__(self, body, fixed, values, f_ext=None, extrapolate: bool = True):
         self.body = body
-        self.extrapolate = bool(extrapolate)
+        self.extrapolate = boolean("extrapolate", extrapolate)
         self._last = None
         n = body.ndofs
-        self.fixed = np.asarray(fixed, dtype=np.int64)
-        self.values = np.broadcast_to(np.asarray(values, dtype=float), self.fixed.shape).copy()
+        self.fixed = array("fixed (dofs)", fixed, dtype=np.int64, ndim=1)
+        values = array("values", values)
+        if values.ndim > 1 or values.size not in (1, self.fixed.size):
+            raise ValueError(f"values must be a number or one per fixed dof "
+                             f"({self.fixed.size}), got shape {values.shape}")
+        self.values = np.broadcast_to(values, self.fixed.shape).copy()
         if self.fixed.size and (self.fixed.min() < 0 or self.fixed.max() >= n):
             raise ValueError(f"fixed dofs must lie in [0, {n}), got {self.fixed.min()}.."
                              f"{self.fixed.max()}")
-        self.f_ext = np.zeros(n) if f_ext is None else np.asarray(f_ext, dtype=float)
-        if self.f_ext.shape != (n,):
-            raise ValueError(f"f_ext must have shape ({n},), got {self.f_ext.shape}")
+        self.f_ext = np.zeros(n) if f_ext is None else array("f_ext", f_ext, shape=(n,))
         self.free = np.setdiff1d(np.arange(n), self.fixed)
         self.lam = 0.0
         self.history = []

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .. import checks
 from .validation import _as_degrees
 
 
@@ -18,15 +19,15 @@ def marked_mask(mesh, marked) -> np.ndarray:
     ne = mesh.n_elements
     if marked is None:
         return np.ones(ne, dtype=bool)
-    marked = np.asarray(marked)
-    if marked.dtype == bool:
-        if marked.shape != (ne,):
-            raise ValueError(f"marked mask must have shape ({ne},), got {marked.shape}")
-        return marked
+    if np.asarray(marked).dtype == bool:
+        return checks.array("marked (mask)", marked, shape=(ne,), dtype=bool)
+    # element indices: integers (1.5 is no element), never rounded
+    marked = checks.array("marked (element indices)", marked, ndim=1, dtype=np.int64)
     if marked.size and (marked.min() < 0 or marked.max() >= ne):
-        raise ValueError(f"marked element indices must lie in 0..{ne - 1}")
+        raise ValueError(f"marked element indices must lie in 0..{ne - 1}, got "
+                         f"{marked.min()}..{marked.max()}")
     mask = np.zeros(ne, dtype=bool)
-    mask[marked.astype(int)] = True
+    mask[marked] = True
     return mask
 
 

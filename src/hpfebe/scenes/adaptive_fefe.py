@@ -16,6 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..checks import array, choice, instance, integer, real
 from ..constitutive import PLANES
 from ..contact import ContactSettings, TwoBodyContact
 from ..fem import ElasticBody, distance_to_set, rectangle_mesh
@@ -50,17 +51,16 @@ class FEFEContactScene(FrictionalContactScene):
     master_cells: tuple[int, ...] = (16, 8)
 
     def __post_init__(self):
-        if self.plane not in PLANES:
-            raise ValueError(f"plane must be one of {PLANES}, got {self.plane!r}")
+        choice("plane", self.plane, PLANES)
         for name in ("slave_cells", "master_cells"):
-            v = getattr(self, name)
-            if len(v) != 2 or min(v) < 1:
-                raise ValueError(f"{name} must be two positive cell counts, got {v!r}")
+            v = array(name, getattr(self, name), shape=(2,), dtype=int)
+            if v.min() < 1:
+                raise ValueError(f"{name} must be two positive cell counts, got "
+                                 f"{getattr(self, name)!r}")
         for name in ("E", "u_master", "eps_n_factor", "eps_t_factor"):
-            if not getattr(self, name) > 0:
-                raise ValueError(f"{name} must be positive, got {getattr(self, name)!r}")
-        if self.mu_f < 0:
-            raise ValueError(f"mu_f must be >= 0, got {self.mu_f!r}")
+            real(name, getattr(self, name), positive=True)
+        real("nu", self.nu, lo=-1.0, hi=0.5, lo_open=True, hi_open=True)
+        real("mu_f", self.mu_f, nonnegative=True)
 
     def initial_meshes(self) -> tuple:
         """Labelled triangulations ("left", "right", "bottom", "top") of both
@@ -71,12 +71,13 @@ class FEFEContactScene(FrictionalContactScene):
     def solve(self, meshes, load_steps: int, settings: ContactSettings):
         """The two-body problem on the meshes (slave, master), the lift applied in
         ``load_steps`` equal increments: (problem, result)."""
+        n = integer("load_steps", load_steps, lo=1)
+        instance("settings", settings, ContactSettings)
         S, M = (ElasticBody(m, self.E, self.nu, self.plane) for m in meshes)
         pr = TwoBodyContact(S, M, CONTACT_BOUNDARY["slave"], CONTACT_BOUNDARY["master"],
                             eps_n=1.0 / (self.eps_n_factor * self.E),
                             eps_t=1.0 / (self.eps_t_factor * self.E), mu_f=self.mu_f)
         fixed, is_y = pr.stamp_dofs()
-        n = load_steps
         res = pr.solve(None, fixed, self.u_master * is_y,
                        load_factors=np.arange(1, n + 1) / n, settings=settings)
         return pr, res

@@ -15,6 +15,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..adaptivity.mortar_estimator import hp_adapt
+from ..checks import array, choice, integer, real
 from ..bem.lame import LameBEM
 from ..contact.mortar import MortarContact
 from ..geometry import BoundaryMesh
@@ -40,13 +41,12 @@ def model_meshes(n1: int = 16, n2: int = 12, p1: int = 2, p2: int = 2,
     ``side_depth``: Gamma^2_D on the vertical sides of body 2 is {-1,1} x [-side_depth, 0]
     (2 = the whole sides; the thesis prints {-1,1} x [-1,0], i.e. 1, with
     Gamma^2_N = empty); below it the sides are traction free (label "N")."""
-    for name, v in (("n1", n1), ("n2", n2), ("p1", p1), ("p2", p2)):
-        if int(v) != v or v < 1:
-            raise ValueError(f"{name} must be a positive integer, got {v!r}")
-    if radius <= 1.0:
-        raise ValueError(f"radius must exceed 1, got {radius!r}")
-    if geometry not in ("arc", "flat"):
-        raise ValueError(f"geometry must be 'arc' or 'flat', got {geometry!r}")
+    n1, n2, p1, p2 = (integer(name, v, lo=1) for name, v in
+                      (("n1", n1), ("n2", n2), ("p1", p1), ("p2", p2)))
+    radius = real("radius", radius, lo=1.0, lo_open=True)       # "must exceed 1"
+    L = real("L", L, positive=True)
+    side_depth = real("side_depth", side_depth, lo=0.0, hi=2.0, lo_open=True)
+    geometry = choice("geometry", geometry, ("arc", "flat"))
     yc = radius                                       # centre (0, R): arc through (0, 0)
     half = np.arcsin(1.0 / radius)
     ang = np.linspace(-half, half, int(n1) + 1)
@@ -62,8 +62,6 @@ def model_meshes(n1: int = 16, n2: int = 12, p1: int = 2, p2: int = 2,
         verts = np.array([[-1.0, 0.0], [1.0, 0.0], [1.0, 2.0], [-1.0, 2.0]])
         n_sides, labels = [int(n1), ns, ns, ns], ["C", "N", "D", "N"]
     mesh1 = BoundaryMesh.polygon(verts, n=n_sides, labels=labels, p=int(p1))
-    if not (np.isfinite(side_depth) and 0.0 < side_depth <= 2.0):
-        raise ValueError(f"side_depth must lie in (0, 2], got {side_depth!r}")
     k2 = int(np.ceil(2.0 / h2 - 1e-9))
     if side_depth >= 2.0:
         mesh2 = BoundaryMesh.polygon([(-1, -2), (1, -2), (1, 0), (-1, 0)],
@@ -90,8 +88,7 @@ def model_meshes(n1: int = 16, n2: int = 12, p1: int = 2, p2: int = 2,
 def model_gap(radius: float = 5.05):
     """The initial gap of the "flat" scene: the height of the arc through (-1, 0.1),
     (0, 0), (1, 0.1) above Gamma_C, g(x) = R - (R^2 - x^2)^(1/2)."""
-    if radius <= 1.0:
-        raise ValueError(f"radius must exceed 1, got {radius!r}")
+    radius = real("radius", radius, lo=1.0, lo_open=True)
 
     def gap(x):
         x = np.asarray(x, dtype=float)
@@ -107,6 +104,7 @@ def contact_from_meshes(mesh1, mesh2, normal, E: float = E, nu: float = NU,
     """The model problem's boundary conditions on given meshes (e.g. adaptive ones);
     ``gap``: the initial gap function (None: measured along the normal to mesh2)."""
     bem1, bem2 = LameBEM(mesh1, E, nu, plane), LameBEM(mesh2, E, nu, plane)
+    u_top = tuple(array("u_top", u_top, shape=(2,)))
     return _model_contact(bem1, bem2, normal, F, u_top, test_space, gap)
 
 
@@ -136,8 +134,8 @@ def model_problem(n1: int = 16, n2: int = 12, p1: int = 2, p2: int = 2,
     depends only on (n1, p1, radius, L, geometry), body 2 on (n2, p2, L, side_depth), so
     a sweep over degree pairs assembles each body once.  ``gap``: an initial gap function
     replacing the scene's (e.g. zero: Algorithm 4.5's step 3 as printed, without g)."""
-    if not np.isfinite(F) or F < 0:
-        raise ValueError(f"F must be >= 0, got {F!r}")
+    F = real("F", F, nonnegative=True)
+    u_top = tuple(array("u_top", u_top, shape=(2,)))
     mesh1, mesh2, normal = model_meshes(n1, n2, p1, p2, radius, L, side_depth, geometry)
     if gap is None and geometry == "flat":
         gap = model_gap(radius)

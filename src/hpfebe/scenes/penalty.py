@@ -26,6 +26,7 @@ import numpy as np
 
 from ..analysis import energy_norm
 from ..bem.lame import LameBEM
+from ..checks import array, choice, integer, real
 from ..constitutive.materials import PLANES
 from ..contact.limits import MACHEPS, constrained_limit, solve_penalty_checked
 from ..contact.penalty import solve_penalty
@@ -82,23 +83,36 @@ class PenaltyScene:
     max_newton_iterations: int = 30
 
     def __post_init__(self):
-        if len(self.n_per_side) < 3 or min(self.n_per_side) < 1:
-            raise ValueError(f"n_per_side needs >= 3 meshes (Aitken) of n >= 1, got "
-                             f"{self.n_per_side}")
-        if not self.C_eps or min(self.C_eps) <= 0:
-            raise ValueError(f"C_eps must be a non-empty list of positive numbers, got "
-                             f"{self.C_eps}")
-        if any(e <= 0 for e in self.fixed_eps):
-            raise ValueError(f"fixed_eps must be positive, got {self.fixed_eps}")
-        if not self.planes or any(pl not in PLANES for pl in self.planes):
+        _counts("n_per_side", self.n_per_side, 3, "meshes (Aitken) of n >= 1")
+        _positives("C_eps", self.C_eps, 1)
+        _positives("fixed_eps", self.fixed_eps, 0)
+        if isinstance(self.planes, str) or not self.planes:
             raise ValueError(f"planes must be a non-empty subset of {PLANES}, got "
-                             f"{self.planes}")
-        if not (self.d > 0 and self.norm_scale > 0):
-            raise ValueError(f"d and norm_scale must be positive, got {self.d}, "
-                             f"{self.norm_scale}")
-        if self.max_newton_iterations < 1:
-            raise ValueError(f"max_newton_iterations must be >= 1, got "
-                             f"{self.max_newton_iterations}")
+                             f"{self.planes!r}")
+        for pl in self.planes:
+            choice("planes entry", pl, PLANES)
+        real("E", self.E, positive=True)
+        real("nu", self.nu, lo=-1.0, hi=0.5, lo_open=True, hi_open=True)
+        real("d", self.d, positive=True)
+        real("norm_scale", self.norm_scale, positive=True)
+        integer("max_newton_iterations", self.max_newton_iterations, lo=1)
+
+
+def _counts(name: str, values, least: int, what: str = "entries >= 1") -> np.ndarray:
+    """A sequence of at least ``least`` integers >= 1 (a parameter check)."""
+    v = array(name, values, ndim=1, dtype=int)
+    if v.size < least or (v.size and v.min() < 1):
+        raise ValueError(f"{name} needs >= {least} {what}, got {values!r}")
+    return v
+
+
+def _positives(name: str, values, least: int) -> np.ndarray:
+    """A sequence of at least ``least`` positive finite reals (a parameter check)."""
+    v = array(name, values, ndim=1)
+    if v.size < least or np.any(v <= 0):
+        raise ValueError(f"{name} must be a list of {'>= %d ' % least if least else ''}"
+                         f"positive numbers, got {values!r}")
+    return v
 
 
 
@@ -148,16 +162,14 @@ class HpRateParams:
     C_ref: float = 1e-10                            # eps_ref = C_ref h_ref / p_ref
 
     def __post_init__(self):
-        if len(self.n_per_side) < 2:
-            raise ValueError(f"hp_rate.n_per_side needs >= 2 meshes, got {self.n_per_side}")
-        if not 0 < self.epsilon < 0.5:
-            raise ValueError(f"hp_rate.epsilon must lie in (0, 1/2) (Theorem 3.2.6), got "
-                             f"{self.epsilon}")
-        if not self.p or min(self.p) < 1:
-            raise ValueError(f"hp_rate.p must be degrees >= 1, got {self.p}")
-        if not self.C_pen or min(self.C_pen) <= 0 or self.C_ref <= 0:
-            raise ValueError(f"hp_rate.C_pen and C_ref must be positive, got {self.C_pen}, "
-                             f"{self.C_ref}")
+        _counts("hp_rate.n_per_side", self.n_per_side, 2, "meshes")
+        real("hp_rate.epsilon (Theorem 3.2.6)", self.epsilon, lo=0.0, hi=0.5,
+             lo_open=True, hi_open=True)
+        _counts("hp_rate.p", self.p, 1, "degrees >= 1")
+        _positives("hp_rate.C_pen", self.C_pen, 1)
+        real("hp_rate.C_ref", self.C_ref, positive=True)
+        integer("hp_rate.n_ref", self.n_ref, lo=1)
+        integer("hp_rate.p_ref", self.p_ref, lo=1)
         if any(self.n_ref % n for n in self.n_per_side) or self.p_ref < max(self.p):
             raise ValueError(f"hp_rate.n_ref = {self.n_ref} must be a multiple of every n in "
                              f"{self.n_per_side} and p_ref = {self.p_ref} >= max p")
@@ -176,16 +188,22 @@ class StabilityParams:
     accept_backward_error_macheps: float = 20.0
 
     def __post_init__(self):
-        if any(pr not in ("flat", "tilted") for pr in self.problems):
-            raise ValueError(f"stability.problems must be 'flat' or 'tilted', got "
-                             f"{self.problems}")
-        if min(self.C_eps, default=1.0) <= 0 or list(self.C_eps) != sorted(self.C_eps,
-                                                                           reverse=True):
+        if isinstance(self.problems, str):
+            raise ValueError(f"stability.problems must be a list of 'flat' / 'tilted', got "
+                             f"{self.problems!r}")
+        for pr in self.problems:
+            choice("stability.problems entry", pr, ("flat", "tilted"))
+        c = _positives("stability.C_eps", self.C_eps, 0)
+        if np.any(np.diff(c) > 0):
             raise ValueError(f"stability.C_eps must be positive and decreasing, got "
                              f"{self.C_eps}")
-        if self.n_per_side < 1 or not self.p or min(self.p) < 1:
-            raise ValueError(f"stability.n_per_side and p must be >= 1, got "
-                             f"{self.n_per_side}, {self.p}")
+        integer("stability.n_per_side", self.n_per_side, lo=1)
+        _counts("stability.p", self.p, 1, "degrees >= 1")
+        real("stability.tilt_slope", self.tilt_slope)
+        real("stability.accept_relative_residual", self.accept_relative_residual,
+             positive=True)
+        real("stability.accept_backward_error_macheps",
+             self.accept_backward_error_macheps, positive=True)
 
 
 @dataclass(frozen=True)

@@ -18,6 +18,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..checks import choice, integer, real
 from ..constitutive.j2 import J2Material
 from ..contact import LU_ORDERINGS, ContactSettings
 from .materials import E, H, NU, SIGMA_Y
@@ -100,14 +101,17 @@ class StampingScene:
     lu_ordering: str = "MMD_AT_PLUS_A"   # sparse LU ordering (ContactSettings)
 
     def __post_init__(self):
-        if self.lu_ordering not in LU_ORDERINGS:
-            raise ValueError(f"lu_ordering must be one of {LU_ORDERINGS}, got "
-                             f"{self.lu_ordering!r}")
-        if self.bebe_cells not in ("quad", "crossed"):
-            raise ValueError(f"bebe_cells must be 'quad' or 'crossed', got {self.bebe_cells!r}")
+        choice("lu_ordering", self.lu_ordering, LU_ORDERINGS)
+        choice("bebe_cells", self.bebe_cells, ("quad", "crossed"))
         for name in ("ex1_u", "ex2_u"):
-            if not getattr(self, name) > 0:
-                raise ValueError(f"{name} must be positive, got {getattr(self, name)!r}")
+            real(name, getattr(self, name), positive=True)
+        integer("n_load", self.n_load, lo=1)
+        integer("n_unload", self.n_unload, lo=0)
+        integer("be_degree", self.be_degree, lo=1)
+        # the material (every theta) and the contact settings are checked now, not at
+        # the first run
+        self.material(1.0)
+        self.settings  # noqa: B018 (validates mu_f, the penalty and Newton settings)
 
     @property
     def settings(self) -> StampContact:

@@ -26,6 +26,7 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
+from ..checks import array, real
 from ..constitutive.j2 import J2Material
 from ..contact.mortar_fe import FEMortarContact
 from ..solvers import DtNSettings, UzawaSettings
@@ -50,8 +51,10 @@ def section44_scene(stamp_cells=(10, 20), work_cells=(61, 31), E: float = E,
     work piece [-2, 2] x [-2, 0] (``work_cells``) whose bottom is displaced by
     (0, ``lift``); plane strain, Tresca friction F on the stamp's bottom."""
     for name, cells in (("stamp_cells", stamp_cells), ("work_cells", work_cells)):
-        if len(cells) != 2 or any(int(k) != k or k < 1 for k in cells):
+        k = array(name, cells, shape=(2,), dtype=int)
+        if np.any(k < 1):
             raise ValueError(f"{name} must be two positive integers, got {cells!r}")
+    lift = real("lift", lift)
     stamp = ElasticBody(rectangle_mesh(*STAMP, *map(int, stamp_cells)), E, nu)
     work = ElastoPlasticFE(rectangle_mesh(*WORK, *map(int, work_cells)),
                            J2Material(E, nu, sigma_Y, H, theta), formulation)

@@ -38,12 +38,13 @@ from typing import Callable
 import numpy as np
 
 from ..bem.lame import LameBEM
+from ..checks import array, boolean, choice, instance, integer, real
 from ..geometry import BoundaryMesh
 from ..fem.elasticity import ElasticBody, rectangle_mesh
 from ..fem.plastic_body import ElastoPlasticFE
 from ..constitutive.j2 import J2Material
 from ..bodies import BEBody, PlasticBEBody, PlasticFEBody
-from ..bodies.plastic_be import rectangle_work_piece
+from ..bodies.plastic_be import ElastoPlasticBE, rectangle_work_piece
 from ..contact.loading import LoadSteps
 from ..contact.settings import ContactSettings
 from ..contact.two_body import TwoBodyContact
@@ -51,6 +52,7 @@ from ..solvers import Iterate, SolverInfo, load_path
 
 SIDES = ("bottom", "right", "top", "left")
 STAMP_KINDS = ("FE", "BE")
+MESH_KINDS = ("quad", "tri")
 
 
 #: the solver of the touches: Newton to rtol = 1e-8 of the force scale, at most 40
@@ -76,7 +78,8 @@ class StampContact:
     with the stamp and the work piece swapped; contact stiffness about 2/eps_n on a flat
     interface, the single pass at eps/2 there); False = the thesis's single pass.
     ``solver``: the :class:`ContactSettings` of the touches (:data:`STAMP_SOLVER`; a
-    touch adds its absolute floor ``atol``, ``max_cuts`` counts per increment)."""
+    touch sets the floor ``atol`` = rtol x :func:`reference_force`, ``max_cuts`` counts
+    per increment)."""
 
     eps_n_factor: float = 10.0
     eps_t_factor: float = 5.0
@@ -86,20 +89,15 @@ class StampContact:
     solver: ContactSettings = STAMP_SOLVER
 
     def __post_init__(self):
-        for name in ("eps_n_factor", "eps_t_factor"):
-            if not getattr(self, name) > 0:
-                raise ValueError(f"{name} must be positive, got {getattr(self, name)!r}")
-        if self.mu_f < 0:
-            raise ValueError(f"mu_f must be >= 0, got {self.mu_f!r}")
-        if self.F is not None and (isinstance(self.F, bool) or not isinstance(
-                self.F, (int, float, np.integer, np.floating)) or not np.isfinite(self.F)
-                or self.F < 0):
-            raise ValueError(f"F (Tresca bound) must be None or a finite number >= 0, got "
-                             f"{self.F!r}")
-        if not isinstance(self.two_pass, (bool, np.bool_)):
-            raise ValueError(f"two_pass must be a bool, got {self.two_pass!r}")
-        if not isinstance(self.solver, ContactSettings):
-            raise ValueError(f"solver must be a ContactSettings, got {self.solver!r}")
+        checked = dict(eps_n_factor=real("eps_n_factor", self.eps_n_factor, positive=True),
+                       eps_t_factor=real("eps_t_factor", self.eps_t_factor, positive=True),
+                       mu_f=real("mu_f", self.mu_f, nonnegative=True),
+                       F=real("F (Tresca bound)", self.F, nonnegative=True,
+                              allow_none=True),
+                       two_pass=boolean("two_pass", self.two_pass))
+        for name, value in checked.items():
+            object.__setattr__(self, name, value)
+        instance("solver", self.solver, ContactSettings)
 
     def friction(self) -> dict:
         """The friction keywords of :class:`TwoBodyContact`: Coulomb ``mu_f`` (F None)
@@ -146,13 +144,14 @@ class TouchResult:
 
 def stamp_body(kind: str, box, h: float, E: float, nu: float, p: int = 1,
                mesh_kind: str = "quad"):
-    """The elastic stamp on ``box`` = (x0, x1, y0, y1) with mesh size h: FE (Q1/P1
-    rectangle mesh) or BE (Galerkin, degree p, the four sides labelled like the FE
-    mesh)."""
-    if kind not in STAMP_KINDS:
-        raise ValueError(f"kind must be one of {STAMP_KINDS}, got {kind!r}")
-    x0, x1, y0, y1 = box
+    """The elastic stamp on ``box`` = (x0, x1, y0, y1) (x0 < x1, y0 < y1) with mesh size
+    h: FE (Q1/P1 rectangle mesh) or BE (Galerkin, degree p, the four sides labelled like
+    the FE mesh)."""
+    choice("kind", kind, STAMP_KINDS)
+    choice("mesh_kind", mesh_kind, MESH_KINDS)
+    x0, x1, y0, y1 = _box(box)
     nx, ny = _cells(x1 - x0, h), _cells(y1 - y0, h)
+    p = integer("p", p, lo=1)
     if kind == "FE":
         return ElasticBody(rectangle_mesh(x0, x1, y0, y1, nx, ny, mesh_kind), E, nu)
     mesh = BoundaryMesh.polygon([(x0, y0), (x1, y0), (x1, y1), (x0, y1)],
@@ -162,23 +161,33 @@ def stamp_body(kind: str, box, h: float, E: float, nu: float, p: int = 1,
 
 def work_piece(box, h: float, material: J2Material, formulation: str = "bbar",
                mesh_kind: str = "quad") -> ElastoPlasticFE:
-    x0, x1, y0, y1 = box
+    """The elastoplastic Q1/P1 work piece on ``box`` = (x0, x1, y0, y1) with mesh size h."""
+    instance("material", material, J2Material)
+    choice("mesh_kind", mesh_kind, MESH_KINDS)
+    x0, x1, y0, y1 = _box(box)
     m = rectangle_mesh(x0, x1, y0, y1, _cells(x1 - x0, h), _cells(y1 - y0, h), mesh_kind)
     return ElastoPlasticFE(m, material, formulation)
 
 
+def _box(box) -> tuple:
+    """(x0, x1, y0, y1) of a rectangle: four finite reals with x0 < x1 and y0 < y1."""
+    x0, x1, y0, y1 = (float(v) for v in array("box (x0, x1, y0, y1)", box, shape=(4,)))
+    if not (x0 < x1 and y0 < y1):
+        raise ValueError(f"box (x0, x1, y0, y1) must have x0 < x1 and y0 < y1, got "
+                         f"{tuple(box)!r}")
+    return x0, x1, y0, y1
+
+
 def _cells(length: float, h: float) -> int:
-    if not h > 0:
-        raise ValueError(f"h must be positive, got {h!r}")
+    h = real("h", h, positive=True)
     return max(1, int(round(length / h)))
 
 
 def lift_schedule(u_total: float, n_load: int, n_unload: int) -> np.ndarray:
     """g after each increment: n_load equal steps up to u_total, n_unload down to 0."""
-    for name, n in (("n_load", n_load), ("n_unload", n_unload)):
-        if isinstance(n, bool) or int(n) != n or n < (1 if name == "n_load" else 0):
-            raise ValueError(f"{name} must be an integer >= {1 if name == 'n_load' else 0}, "
-                             f"got {n!r}")
+    u_total = real("u_total", u_total)
+    n_load = integer("n_load", n_load, lo=1)
+    n_unload = integer("n_unload", n_unload, lo=0)
     up = u_total * np.arange(1, n_load + 1) / n_load
     down = u_total * (1.0 - np.arange(1, n_unload + 1) / n_unload) if n_unload else []
     return np.concatenate([up, down])
@@ -274,12 +283,13 @@ class TouchSteps:
             self.on_increment(k, self.contact.pr.result(it, info, self.contact))
 
 
-def _touch_path(pr, fixed, is_y, work_y, lifts, settings: StampContact, atol: float,
+def _touch_path(pr, fixed, is_y, work_y, lifts, settings: StampContact, force: float,
                 on_increment, touch_id: int) -> TouchResult:
-    """All increments of one touch (lifts ``lifts``) as one load path; ``atol`` the
-    absolute floor of the stopping test.  A failed increment (after ``max_cuts`` cuts)
-    ends the touch with its reason."""
-    solver = dataclasses.replace(settings.solver, atol=atol)
+    """All increments of one touch (lifts ``lifts``) as one load path; ``force`` the
+    reference force of the stopping test (:func:`reference_force`: the floor atol =
+    rtol x force).  A failed increment (after ``max_cuts`` cuts) ends the touch with its
+    reason."""
+    solver = dataclasses.replace(settings.solver, atol=settings.solver.rtol * force)
     steps = TouchSteps(pr, fixed, is_y, lifts, work_y, solver, on_increment)
     _, info = load_path(steps, np.arange(1.0, len(lifts) + 1), steps.contact.x0,
                         max_cuts=solver.max_cuts, cuts_per_step=True,
@@ -293,12 +303,33 @@ def _touch_path(pr, fixed, is_y, work_y, lifts, settings: StampContact, atol: fl
     return out
 
 
-def _absolute_floor(settings: StampContact, material: J2Material, width: float) -> float:
-    """The absolute floor of the stopping test: rtol x sigma_Y x width, the force scale
-    of the plastic work piece (when the stamp is lifted off, the forces at equilibrium
-    shrink to residual stresses and the relative test alone asks for more digits);
-    sigma_Y capped at 1e-3 E (J2Material.stress_floor)."""
-    return settings.solver.rtol * material.stress_floor * width
+def _extent(points: np.ndarray) -> tuple[float, float]:
+    """(width, height) of the bounding box of points (2, n)."""
+    return float(np.ptp(points[0])), float(np.ptp(points[1]))
+
+
+def _stamp_extent(stamp) -> tuple[float, float]:
+    return _extent(stamp.mesh.p if isinstance(stamp, ElasticBody) else stamp.mesh.nodes.T)
+
+
+def reference_force(stamp, material: J2Material, work_size, u_total: float,
+                    settings: StampContact) -> float:
+    """The reference force of a touch's stopping test (the floor atol = rtol x this
+    force; the backward-error rule of :mod:`hpfebe.solvers.info`): the work piece's
+    width W times the smaller of its yield stress (J2Material.stress_floor: sigma_Y, at
+    most the stress of a 0.1 % strain, 1e-3 E) and the elastic stress of the prescribed
+    lift, |u_total| / (H_s / E_s + H_w / E_w + eps_n) (the stamp, the work piece (heights
+    H_s, H_w) and the normal penalty spring in series).  When the stamp is lifted off,
+    the forces at equilibrium shrink to residual stresses and the relative test alone
+    asks for more digits than round-off leaves; the floor stops there.  Scale-free: it
+    scales with the forces when lengths, moduli or the lift are scaled (a yield force
+    alone did not: a stamp pressed by 4.2e-12 had its start accepted after 0 iterations
+    with a force 14.7 x the linear one).  ``work_size``: (W, H_w)."""
+    W, H_w = work_size
+    H_s = _stamp_extent(stamp)[1]
+    E_w = material.E
+    compliance = H_s / stamp.E + H_w / E_w + 1.0 / (settings.eps_n_factor * E_w)
+    return W * min(material.stress_floor, abs(u_total) / compliance)
 
 
 def touch(stamp, fe: ElastoPlasticFE, u_total: float, n_load: int, n_unload: int,
@@ -307,11 +338,16 @@ def touch(stamp, fe: ElastoPlasticFE, u_total: float, n_load: int, n_unload: int
     peak and the work piece's total displacement at the end (the offset of a next
     touch).  A failed increment (after ``max_cuts`` cuts) ends the touch with its reason;
     the committed history is that of the last converged increment."""
+    instance("fe", fe, ElastoPlasticFE)
+    X, touch_id = _touch_args(stamp, X, settings, touch_id)
+    lifts = lift_schedule(u_total, n_load, n_unload)
+    n_load = integer("n_load", n_load)
+    if offset is not None:
+        offset = array("offset", offset, shape=(fe.ndofs,))
     body = PlasticFEBody(fe, offset)
     pr, fixed, is_y = _stamp_on_work(stamp, body, fe.material.E, settings)
     bottom_y = fe.elastic.dofs_on("bottom", 1)
     work_y = pr.global_dofs("master", fe.elastic.nodal_dofs[1])
-    lifts = lift_schedule(u_total, n_load, n_unload)
     records, last = [], {}
 
     def on_increment(k: int, res) -> None:
@@ -325,13 +361,23 @@ def touch(stamp, fe: ElastoPlasticFE, u_total: float, n_load: int, n_unload: int
             last["peak"] = Snapshot(touch_id, stamp, res.u_slave.copy(),
                                     body.offset + res.u_master, _mean_fields(fe), res)
 
-    atol = _absolute_floor(settings, fe.material, float(np.ptp(fe.mesh.p[0])))
-    out = _touch_path(pr, fixed, is_y, work_y, lifts, settings, atol, on_increment,
+    force = reference_force(stamp, fe.material, _extent(fe.mesh.p), float(u_total),
+                            settings)
+    out = _touch_path(pr, fixed, is_y, work_y, lifts, settings, force, on_increment,
                       touch_id)
     out.records, out.peak = records, last.get("peak")
     if "res" in last:
         out.u_work = body.offset + last["res"].u_master
     return out
+
+
+def _touch_args(stamp, X, settings, touch_id):
+    """The checked arguments every touch shares: the stamp's kind, X (a point) and the
+    settings; returns (X, touch_id)."""
+    instance("stamp", stamp, (ElasticBody, LameBEM), "an elastic stamp (ElasticBody or "
+             "LameBEM, stamp_body)")
+    instance("settings", settings, StampContact)
+    return array("X", X, shape=(2,)), integer("touch_id", touch_id, lo=1)
 
 
 def _mean_fields(fe: ElastoPlasticFE) -> dict:
@@ -437,11 +483,13 @@ def touch_be(stamp, be, u_total: float, n_load: int, X, settings: StampContact,
     the bottom y dofs), ||dev sigma|| and ||eps_p|| of the cells touching X.  The
     snapshot's ``u_work`` is the BE boundary displacement; its ``fields`` the cell fields
     plus the cell-node displacement ``node_u`` (representation formula)."""
+    instance("be", be, ElastoPlasticBE)
+    X, touch_id = _touch_args(stamp, X, settings, touch_id)
+    lifts = lift_schedule(u_total, n_load, 0)
     body = PlasticBEBody(be)
     pr, fixed, is_y = _stamp_on_work(stamp, body, be.material.E, settings)
     by_local = body.dofs_on("bottom", 1)
     work_y = pr.global_dofs("master", np.arange(1, be.ndofs, 2))
-    lifts = lift_schedule(u_total, n_load, 0)
     records, last = [], {}
 
     def on_increment(k: int, res) -> None:
@@ -451,8 +499,9 @@ def touch_be(stamp, be, u_total: float, n_load: int, X, settings: StampContact,
             touch_id, "load", float(lifts[k]), force, be.value_at("dev_sigma_norm", X),
             be.value_at("eps_p_norm", X), int(res.info.iterations), len(res.info.steps)))
 
-    atol = _absolute_floor(settings, be.material, float(np.ptp(be.bem.mesh.nodes[:, 0])))
-    out = _touch_path(pr, fixed, is_y, work_y, lifts, settings, atol, on_increment,
+    force = reference_force(stamp, be.material, _extent(be.bem.mesh.nodes.T),
+                            float(u_total), settings)
+    out = _touch_path(pr, fixed, is_y, work_y, lifts, settings, force, on_increment,
                       touch_id)
     out.records = records
     if "res" in last:

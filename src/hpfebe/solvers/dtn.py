@@ -36,9 +36,10 @@ from typing import Any, Callable, Protocol
 
 import numpy as np
 
+from ..checks import boolean, choice, instance, integer, real
 from .fixed_point import fixed_point
 from .info import SolverInfo
-from .uzawa import UzawaSettings
+from .uzawa import UzawaSettings, _set
 
 TRANSFERS = ("functional", "function")
 RELAXATIONS = ("increment", "convex")
@@ -65,16 +66,16 @@ class DtNSettings:
     uzawa: UzawaSettings = field(default_factory=UzawaSettings)
 
     def __post_init__(self):
-        for name in ("omega_D", "omega_N"):
-            w = getattr(self, name)
-            if not (np.isfinite(w) and 0.0 < w <= 1.0):
-                raise ValueError(f"{name} must lie in (0, 1], got {w!r}")
-        if self.transfer not in TRANSFERS:
-            raise ValueError(f"transfer must be 'functional' or 'function', got "
-                             f"{self.transfer!r}")
-        if self.relaxation not in RELAXATIONS:
-            raise ValueError(f"relaxation must be one of {RELAXATIONS}, got "
-                             f"{self.relaxation!r}")
+        for name in ("omega_D", "omega_N"):         # "must lie in (0, 1]"
+            _set(self, name, real(name, getattr(self, name), lo=0.0, hi=1.0,
+                                  lo_open=True))
+        for name in ("tol", "divergence"):
+            _set(self, name, real(name, getattr(self, name), positive=True))
+        _set(self, "max_iter", integer("max_iter", self.max_iter, lo=1))
+        _set(self, "aitken", boolean("aitken", self.aitken))
+        choice("transfer", self.transfer, TRANSFERS)
+        choice("relaxation", self.relaxation, RELAXATIONS)
+        instance("uzawa", self.uzawa, UzawaSettings)
         if self.aitken and self.relaxation != "increment":
             raise ValueError("aitken relaxes the increment form: relaxation must be "
                              "'increment'")

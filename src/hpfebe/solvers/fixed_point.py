@@ -7,6 +7,7 @@ from typing import Any, Callable
 
 import numpy as np
 
+from ..checks import InputTypeError, array, integer, real
 from .info import SolverInfo, residual_norm
 
 
@@ -22,11 +23,14 @@ def fixed_point(update: Callable[[np.ndarray], Any], x0: np.ndarray, tol: float,
     max(||x_{k+1}||, tiny) (relative increment, ``info.residuals``); "diverged" when
     the increment is not finite or exceeds ``divergence`` times the smallest increment
     seen; "max_iter" after ``max_iter`` updates.  Returns (x, SolverInfo)."""
-    if not (np.isfinite(tol) and tol > 0):
-        raise ValueError(f"tol must be positive and finite, got {tol!r}")
-    if isinstance(max_iter, bool) or int(max_iter) != max_iter or max_iter < 1:
-        raise ValueError(f"max_iter must be a positive integer, got {max_iter!r}")
-    x = np.asarray(x0, dtype=float)
+    tol = real("tol", tol, positive=True)
+    max_iter = integer("max_iter", max_iter, lo=1)
+    min_iter = integer("min_iter", min_iter, lo=1)
+    divergence = real("divergence", divergence, positive=True, finite=False)
+    if not callable(update):
+        raise InputTypeError(f"update must be a callable x -> next iterate, got "
+                             f"{update!r}")
+    x = array("x0", x0)
     info = SolverInfo(False, "max_iter")
     smallest = np.inf
     for k in range(1, int(max_iter) + 1):

@@ -9,6 +9,7 @@ from typing import Protocol
 
 import numpy as np
 
+from ..checks import array, boolean, integer, real
 from .info import Iterate, NewtonProblem, SolverInfo
 from .newton import newton
 
@@ -27,12 +28,21 @@ class LoadStep(Protocol):
 
 def load_path(steps: LoadStep, factors, x0: np.ndarray, max_cuts: int = 0,
               lam0: float = 0.0, cuts_per_step: bool = False, **newton_kw):
-    """Algorithm 4.1: Newton for every load factor of the increasing sequence
-    ``factors``, the history committed after each converged step; a failed step is cut
+    """Algorithm 4.1: Newton for every load factor of the sequence ``factors`` (usually
+    increasing; an unloading path may turn back, no factor repeats the one before), the history committed after each converged step; a failed step is cut
     in half and retried from the committed state, at most ``max_cuts`` times in all
     (``cuts_per_step``: at most ``max_cuts`` times between two factors of ``factors``).
     Returns (last iterate, SolverInfo with one SolverInfo per attempted step in
     ``steps``)."""
+    factors = array("load factors", factors, ndim=1, min_size=1)
+    lam0 = real("lam0", lam0)
+    # loading and unloading alike (a path may turn back); a repeated factor is a step of
+    # length zero, whose cut would be the committed state itself
+    if np.any(np.diff(np.concatenate([[lam0], factors])) == 0):
+        raise ValueError(f"load factors must each differ from the one before (the first "
+                         f"from lam0 = {lam0:g}), got {factors.tolist()!r}")
+    max_cuts = integer("max_cuts", max_cuts, lo=0)
+    cuts_per_step = boolean("cuts_per_step", cuts_per_step)
     queue = [float(f) for f in factors]
     given = set(queue)              # the factors asked for (the others are cuts)
     x, last = np.asarray(x0, dtype=float), None

@@ -10,8 +10,9 @@ from typing import Callable
 
 import numpy as np
 
-from .info import EPS, Iterate, NewtonProblem, SingularStep, SolverInfo, residual_norm, \
-    roundoff_verdict
+from ..checks import array, integer, real
+from .info import EPS, Iterate, NewtonProblem, SingularStep, SolverInfo, backward_error, \
+    is_converged, residual_norm, roundoff_verdict
 
 
 @dataclass
@@ -51,6 +52,11 @@ def newton(problem: NewtonProblem, x0: np.ndarray, tol: float, max_iter: int = 5
            roundoff_stop: bool = False, divergence: float = 1e12):
     """Semismooth Newton from x0.  Returns (final iterate, SolverInfo).
 
+    Stopping test (the backward-error rule of :mod:`.info`): ||R|| <= atol + tol * scale,
+    ``atol`` tol times a reference force of the problem's data (never a constant: a
+    floor above the forces of the data accepts a wrong start).
+    ``info.backward_error`` is ||R|| / (scale + atol / tol) of the returned iterate.
+
     ``predictor``: an optional first candidate (e.g. a linear "bonded" solution), taken
     when its merit is lower; it counts as an iteration.  ``roundoff_stop``: a Newton
     update at round-off level relative to x ends the iteration as converged (for
@@ -61,13 +67,29 @@ def newton(problem: NewtonProblem, x0: np.ndarray, tol: float, max_iter: int = 5
     the iteration ("cycling"), or as converged if the step was at round-off level
     (stagnation).  Divergence: a non-finite residual, or one above ``divergence`` times
     the initial residual and force scale."""
+    tol = real("tol", tol, nonnegative=True)
+    atol = real("atol", atol, nonnegative=True)
+    if tol == 0 and atol == 0:
+        raise ValueError("tol and atol must not both be zero")
+    max_iter = integer("max_iter", max_iter, lo=0)
+    x0 = array("x0", x0)
     ls = line_search or LineSearch()
-    it = problem.evaluate(np.asarray(x0, dtype=float))
-    res = [residual_norm(it.residual, norm)]
-    info = SolverInfo(False, "max_iter", 0, res, [], [it.merit])
+    it = problem.evaluate(x0)
+    info = SolverInfo(False, "max_iter", 0, [residual_norm(it.residual, norm)], [],
+                      [it.merit])
+    it, info = _iterate(problem, it, info, tol, max_iter, atol, norm, ls, predictor,
+                        roundoff_stop, divergence)
+    info.backward_error = backward_error(it, norm, tol, atol)
+    return it, info
+
+
+def _iterate(problem, it, info, tol, max_iter, atol, norm, ls, predictor, roundoff_stop,
+             divergence):
+    """The iteration of :func:`newton` from the evaluated start ``it``."""
+    res = info.residuals
 
     def done(i: Iterate) -> bool:
-        return residual_norm(i.residual, norm) <= atol + tol * i.scale
+        return is_converged(i, norm, tol, atol)
 
     if done(it):
         info.converged, info.reason = True, "converged"
@@ -95,7 +117,8 @@ def newton(problem: NewtonProblem, x0: np.ndarray, tol: float, max_iter: int = 5
             # the k-th Newton system was solved (and counts), its update is not taken;
             # converged only if the backward error of the iterate is small
             info.iterations = k
-            roundoff_verdict(info, it, norm, "Newton update at round-off level")
+            roundoff_verdict(info, it, norm, "Newton update at round-off level", tol,
+                             atol)
             return it, info
         alpha, new = _line_search(problem, it, dx, ls)
         if new is None:
@@ -116,7 +139,8 @@ def newton(problem: NewtonProblem, x0: np.ndarray, tol: float, max_iter: int = 5
         if it.key is not None:
             if it.key in seen and it.merit >= seen[it.key][1] - 1e-14 * abs(it.merit):
                 if alpha * np.abs(dx).max() <= 1e-8 * np.abs(it.x).max():
-                    roundoff_verdict(info, it, norm, "stagnation at round-off level")
+                    roundoff_verdict(info, it, norm, "stagnation at round-off level",
+                                     tol, atol)
                 else:
                     info.reason = (f"cycling: contact state of iterate {seen[it.key][0]} "
                                    f"repeated at {k} without decrease of the merit")

@@ -17,6 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit
 
+from ..checks import integer, real
 from .info import SolverInfo
 
 #: status codes of :func:`_polyak_kernel`
@@ -155,12 +156,11 @@ def projected_cg(A, b, upper, x0=None, tol: float = 1e-10, max_iter: int | None 
                          f"{b.shape}, {A.shape}, {u.shape}")
     if x0 is not None and np.shape(x0) != (n,):
         raise ValueError(f"x0 must have shape ({n},), got {np.shape(x0)}")
-    if not (np.isfinite(tol) and tol > 0):
-        raise ValueError(f"tol must be positive, got {tol!r}")
+    tol = real("tol", tol, positive=True)
     if np.any(np.isnan(u)):
         raise ValueError("upper contains NaN")
-    max_iter = 20 * n + 100 if max_iter is None else int(max_iter)
-    return _projected_cg_checked(A, b, u, x0, float(tol), max_iter)
+    max_iter = 20 * n + 100 if max_iter is None else integer("max_iter", max_iter, lo=1)
+    return _projected_cg_checked(A, b, u, x0, tol, max_iter)
 
 
 def _projected_cg_checked(A, b, u, x0, tol: float, max_iter: int):

@@ -16,10 +16,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..checks import integer, real
 from ..constitutive.laws import friction_projection, normal_projection
 from .info import Iterate, SingularStep
 from .newton import newton
-from .uzawa import check_friction
+from .uzawa import _set, check_friction
 
 
 @dataclass(frozen=True)
@@ -33,7 +34,9 @@ class SemismoothSettings:
     mu_f: float = 0.1
 
     def __post_init__(self):
-        check_friction(self.friction, self.mu_f)
+        check_friction(self)
+        _set(self, "tol", real("tol", self.tol, positive=True))
+        _set(self, "max_iter", integer("max_iter", self.max_iter, lo=1))
 
 
 class _Complementarity:

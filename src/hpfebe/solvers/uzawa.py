@@ -15,6 +15,7 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit
 
+from ..checks import boolean, choice, integer, real
 from ..constitutive.laws import friction_projection, normal_projection, tresca_return
 from .fixed_point import fixed_point
 from .pcg import BoundQP, _per_node, _polyak_core, pcg_info
@@ -38,12 +39,15 @@ class UzawaSettings:
 
     def __post_init__(self):
         for name in ("rho", "tol", "cg_tol"):
-            v = getattr(self, name)
-            if not (np.isfinite(v) and v > 0.0):
-                raise ValueError(f"{name} must be positive, got {v!r}")
-        if isinstance(self.max_iter, bool) or int(self.max_iter) != self.max_iter or \
-                self.max_iter < 1:
-            raise ValueError(f"max_iter must be a positive integer, got {self.max_iter!r}")
+            _set(self, name, real(name, getattr(self, name), positive=True))
+        _set(self, "max_iter", integer("max_iter", self.max_iter, lo=1))
+        _set(self, "relative", boolean("relative", self.relative))
+
+
+def _set(settings, name: str, value) -> None:
+    """Store the validated ``value`` of a field of a frozen settings dataclass (a
+    numpy float as a Python float, ...)."""
+    object.__setattr__(settings, name, value)
 
 
 @njit(cache=True)
@@ -147,17 +151,18 @@ class GlobalUzawaSettings:
     divergence: float = 1e6
 
     def __post_init__(self):
-        check_friction(self.friction, self.mu_f)
-        if not (np.isfinite(self.rho) and self.rho > 0.0):
-            raise ValueError(f"rho must be positive, got {self.rho!r}")
+        check_friction(self)
+        for name in ("rho", "tol", "divergence"):
+            _set(self, name, real(name, getattr(self, name), positive=True))
+        _set(self, "max_iter", integer("max_iter", self.max_iter, lo=1))
+        _set(self, "relative", boolean("relative", self.relative))
 
 
-def check_friction(friction: str, mu_f: float) -> None:
-    """ValueError unless ``friction`` is a law of :data:`FRICTIONS` and mu_f >= 0."""
-    if friction not in FRICTIONS:
-        raise ValueError(f"friction must be 'coulomb' or 'tresca', got {friction!r}")
-    if not (np.isfinite(mu_f) and mu_f >= 0):
-        raise ValueError(f"mu_f must be >= 0, got {mu_f!r}")
+def check_friction(settings) -> None:
+    """Validate (and store) ``settings.friction`` (a law of :data:`FRICTIONS`) and
+    ``settings.mu_f`` >= 0 of a frozen settings dataclass."""
+    _set(settings, "friction", choice("friction", settings.friction, FRICTIONS))
+    _set(settings, "mu_f", real("mu_f", settings.mu_f, nonnegative=True))
 
 
 def global_uzawa(response, frame, unframe, gap, F: float, step: float,
