@@ -141,27 +141,6 @@ if workflow.is_main_process:
     os.environ["HPFEBE_PARENT_HOST"] = socket.gethostname()
 
 
-def _main_snakemake_gone():
-    """True if the main Snakemake named by the environment has ended (its pid on this
-    host, else its heartbeat file older than 10 s: hpfebe.suite.watch.watch_heartbeat)."""
-    pid, host = os.environ.get("HPFEBE_PARENT_PID"), os.environ.get("HPFEBE_PARENT_HOST")
-    if not pid:
-        return False
-    if host and host != socket.gethostname():
-        heartbeat = os.environ.get("HPFEBE_HEARTBEAT")
-        try:
-            return bool(heartbeat) and time.time() - os.stat(heartbeat).st_mtime > 10
-        except OSError:
-            return True
-    try:
-        os.kill(int(pid), 0)
-    except ProcessLookupError:
-        return True
-    except (PermissionError, ValueError):
-        pass
-    return False
-
-
 # The SLURM executor plugin (2.8) waits 10 s longer after every status check that saw no
 # job end (up to 180 s): a job ending after a quiet minute was noticed up to 30 s late,
 # on the critical path twice (after numba_cache, after the last job).  In the main
@@ -182,11 +161,26 @@ if workflow.is_main_process:
         _SlurmExecutor.next_seconds_between_status_checks = _interval.setter(_capped)
 
 
-# A cluster job that starts after its main Snakemake was killed (it waited in the queue)
-# stops here, before its Snakemake removes the job's old outputs to rebuild them.
-if not workflow.is_main_process and _main_snakemake_gone():
-    raise WorkflowError("the Snakemake that submitted this job has ended: the job does "
-                        "not run (after an interrupted run: snakemake --unlock, then rerun)")
+# A cluster job's Snakemake removes the job's old outputs just before it runs the job
+# (snakemake.jobs.Job.prepare).  In a SLURM job of a group, one nested Snakemake runs
+# after another, and one may start, or reach that point, after the main Snakemake was
+# killed: there it stops first (the job fails, its old outputs and log untouched; the
+# profile's keep-incomplete keeps a failed job's outputs too).  The check is made at that
+# moment, not when this file is read: a job's Snakemake spends seconds between the two.
+if not workflow.is_main_process:
+    from hpfebe.suite.watch import parent_gone_from_env
+    from snakemake.exceptions import WorkflowError
+    from snakemake.jobs import Job as _Job
+
+    async def _remove_existing_output(self, _remove=_Job.remove_existing_output):
+        if parent_gone_from_env():
+            raise WorkflowError(
+                f"the Snakemake that submitted this job has ended: {self.rule.name} does "
+                "not run and its old outputs are kept (after an interrupted run: "
+                "snakemake --unlock, then rerun)")
+        await _remove(self)
+
+    _Job.remove_existing_output = _remove_existing_output
 
 
 _HEARTBEAT_STOP = threading.Event()

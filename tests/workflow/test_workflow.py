@@ -6,6 +6,7 @@ report/published/ are links to the checkout's."""
 import importlib.util
 import os
 import shutil
+import socket
 import subprocess
 import sys
 from pathlib import Path
@@ -87,11 +88,13 @@ def test_job_commands_do_not_change_between_calls(tree):
     assert "HPFEBE_PARENT_PID" not in runs[0].stdout
 
 
-def test_registry_cache_written_by_the_main_snakemake(tree):
+def test_registry_cache_written_by_the_main_snakemake(tree, monkeypatch):
     """The main Snakemake writes the registry it discovered to .snakemake/hpfebe/ (the
     nested Snakemakes of cluster jobs read it instead of parsing every experiment file
     again, while no file under experiments/ changed)."""
     import pickle
+
+    monkeypatch.syspath_prepend(str(ROOT))      # the pickle names experiments.registry
 
     r = snakemake("-n", cwd=tree)
     assert r.returncode == 0, r.stdout + r.stderr
@@ -259,6 +262,42 @@ def test_no_result_lands_after_the_parent_is_gone(tmp_path):
         parent.kill()
     assert rest.split() == ["landed"], rest
     assert sorted(p.name for p in out.iterdir()) == []
+
+
+def _job_snakemake(tree, parent_pid):
+    """The command a cluster job's nested Snakemake runs (SLURM: srun -> snakemake
+    --mode remote --target-jobs RULE:), for bem_laplace, the main Snakemake named by the
+    environment as ``parent_pid`` on this host."""
+    env = dict(os.environ, HPFEBE_PARENT_PID=str(parent_pid),
+               HPFEBE_PARENT_HOST=socket.gethostname())
+    return subprocess.run(
+        [sys.executable, "-m", "snakemake", "-s", str(ROOT / "Snakefile"), "--mode",
+         "remote", "--target-jobs", "bem_laplace:", "--allowed-rules", "bem_laplace",
+         "--cores", "1", "--force", "--keep-incomplete", "--nolock",
+         "--configfile", "config/quick.yaml"],
+        cwd=tree, env=env, capture_output=True, text=True, timeout=600)
+
+
+def test_job_after_the_kill_keeps_old_outputs(tree):
+    """A job whose Snakemake starts after the main Snakemake was killed (the next job of
+    a SLURM group) fails before Snakemake removes its old outputs; with the main
+    Snakemake alive the same command runs the job."""
+    (tree / "results" / "logs").mkdir(parents=True)
+    (tree / "results" / "logs" / "numba_cache.json").write_text("{}")
+    old = {tree / "results" / f"figure_bem_laplace.{ext}": f"old {ext}\n".encode()
+           for ext in ("csv", "json", "png")}
+    for path, data in old.items():
+        path.write_bytes(data)
+    dead = subprocess.Popen([sys.executable, "-c", "pass"])
+    dead.wait()
+    r = _job_snakemake(tree, dead.pid)
+    assert r.returncode != 0
+    assert "the Snakemake that submitted this job has ended" in r.stdout + r.stderr
+    assert {p: p.read_bytes() for p in old} == old
+
+    r = _job_snakemake(tree, os.getpid())
+    assert r.returncode == 0, r.stdout + r.stderr
+    assert all(p.read_bytes() != data for p, data in old.items())
 
 
 # --------------------------------------------------------------------------- registry

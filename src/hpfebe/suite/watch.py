@@ -86,8 +86,10 @@ def _start_time(pid: int) -> str | None:
 
 
 def _alive(pid: int, start: str | None) -> bool:
-    if start is not None:                         # Linux: same process, not a zombie
-        return _start_time(pid) == start
+    """Process ``pid`` runs and (Linux) is the one that had start time ``start``: a
+    zombie (killed, not yet reaped by its parent) counts as ended."""
+    if os.path.isdir("/proc"):
+        return start is not None and _start_time(pid) == start
     try:
         os.kill(pid, 0)
     except ProcessLookupError:
@@ -199,6 +201,29 @@ def watch_parent_from_env() -> None:
     if pid > 1 and pid != os.getpid():
         watch_parent(pid)
         log.info("this run stops when process %d (the Snakemake that started it) ends", pid)
+
+
+def parent_gone_from_env() -> bool:
+    """True if the Snakemake named by the environment has ended: its pid on this host,
+    else its heartbeat file older than :data:`HEARTBEAT_TIMEOUT_S` (by the file server's
+    clock).  False without the variables (a run by hand).  The Snakefile asks it in a
+    cluster job's Snakemake before that removes a job's old outputs."""
+    value = os.environ.get(PARENT_PID_ENV)
+    try:
+        pid = int(value) if value else None
+    except ValueError:
+        pid = None
+    if pid is None:
+        return False
+    host = os.environ.get(PARENT_HOST_ENV)
+    if host and host != socket.gethostname():
+        heartbeat = os.environ.get(HEARTBEAT_ENV)
+        try:
+            return bool(heartbeat) and time.time() - os.stat(heartbeat).st_mtime > \
+                HEARTBEAT_TIMEOUT_S
+        except OSError:
+            return True
+    return not _alive(pid, _start_time(pid))
 
 
 #: the watches started in this process, as (gone, why): checked again by before_rename
