@@ -102,13 +102,13 @@ def _top_level_keys(f):
 _KEYS = {f: _top_level_keys(f) for f in CONFIG_FILES}
 
 
-def config_flags(exp):
-    """The job's config files: config/config.yaml and each further file that sets this
-    module's section or `quick` (a file that changes only other modules is not part of
-    this job's command, so adding it reruns only those).  The merged top level is
-    checked here, for every file: a misspelt section is an error."""
-    files = [f for i, f in enumerate(CONFIG_FILES)
-             if i == 0 or {exp.name, "quick"} & _KEYS[f]]
+def config_flags(*exps):
+    """The job's config files: config/config.yaml and each further file that sets the
+    section of one of its modules or `quick` (a file that changes only other modules is
+    not part of this job's command, so adding it reruns only those).  The merged top
+    level is checked here, for every file: a misspelt section is an error."""
+    keys = {e.name for e in exps} | {"quick"}
+    files = [f for i, f in enumerate(CONFIG_FILES) if i == 0 or keys & _KEYS[f]]
     return " ".join((["--quick"] if QUICK else [])
                     + [f"--config {shlex.quote(f)}" for f in files])
 
@@ -235,8 +235,8 @@ ALL_RESULTS = [p for e in REGISTRY for p in artefact_outputs(e.artefacts)]
 NUMBA_STAMP = f"{LOGS}/numba_cache.json"
 
 
-def numba_input(exp):
-    return [ancient(NUMBA_STAMP)] if exp.numba else []
+def numba_input(*exps):
+    return [ancient(NUMBA_STAMP)] if any(e.numba for e in exps) else []
 
 
 # Longest jobs first (two jobs on two cores: the run ends when its longest job does):
@@ -278,45 +278,74 @@ def priority_of(rule):
     return len(_ORDER) - _ORDER.index(rule) if JOB_TIMES.get(rule) else 0
 
 
-def slurm_nice(rule):
-    """The job's `sbatch --nice` (a resource function: the profile's --groups are known
-    when the jobs are made, not when this file is read): the number of SLURM jobs
-    measured longer, times the number of jobs.  The SLURM executor does not pass
-    Snakemake's priority on; SLURM starts jobs of equal priority in the order of
-    submission, which is not this one, and (priority/basic) lowers each job's priority by
-    1 against the one before: a step of 1 per place would not outweigh that.  A SLURM job
-    is a job outside the groups, or a group of the profile (its jobs run one after
-    another as one SLURM job: it counts as long as its jobs together, split over the
-    SLURM jobs that `group-components` makes of it); all jobs of a group get the same
-    value (Snakemake refuses a group whose jobs ask for different strings)."""
+# SLURM bundles (profiles/slurm sets `config: [bundles=profiles/slurm/bundles.yaml]`):
+# the jobs of a bundle are one rule, `bundle_<name>`, whose one command runs them one
+# after another in one process (`hpfebe run RULE RULE ...`).  On a cluster each job
+# costs a SLURM job, or in a Snakemake group a nested Snakemake per job (about 1.5 s)
+# besides the interpreter start and imports of each job (about 2.5 s): for the jobs of
+# the quick run, which compute for about a second, that was two thirds of a SLURM run.
+# A bundle reruns as a whole: an edit of one of its modules reruns its bundle-mates too
+# (locally, without the profile, every job stays a rule of its own).
+def _bundles():
+    import yaml
 
-    def nice(wildcards):
-        groups = workflow.group_settings.overwrite_groups
-        parts = workflow.group_settings.group_components
-        units = {r: t for r, t in JOB_TIMES.items() if r not in groups}
-        for g in set(groups.values()):
-            members = [r for r, h in groups.items() if h == g]
-            units[g] = (sum(JOB_TIMES.get(r, 0.0) for r in members)
-                        / math.ceil(len(members) / parts.get(g, 1)))
-        wall = units[groups[rule]] if rule in groups else JOB_TIMES.get(rule, 0.0)
-        longer = sum(t > wall for t in units.values())
-        return f"--nice={len(JOB_TIMES) * longer if wall else len(JOB_TIMES) ** 2}"
-
-    return nice
-
-
-def runtime_min(rule):
-    """A cluster job's time limit, minutes: 5x the recorded wall time (a slower node, a
-    cold numba cache), at least 10 minutes; 60 for a job never measured."""
-    wall = RECORDED_WALL_S.get(rule)
-    return 60 if wall is None else max(10, math.ceil(5 * float(wall) / 60))
+    path = config.get("bundles")
+    if not path:
+        return {}
+    doc = yaml.safe_load(Path(path).read_text()) or {}
+    jobs = {j.rule for j in REGISTRY.jobs}
+    seen = {}
+    if not isinstance(doc, dict):
+        raise ValueError(f"{path}: a mapping of bundle names to lists of jobs expected")
+    for name, rules in doc.items():
+        if not str(name).isidentifier() or not isinstance(rules, list) or not rules:
+            raise ValueError(f"{path}: bundle {name!r} must be a name with a list of jobs")
+        for r in rules:
+            if r not in jobs:
+                raise ValueError(f"{path}: bundle {name!r} names {r!r}, which is no job "
+                                 "(snakemake --list-rules)")
+            if r in seen:
+                raise ValueError(f"{path}: {r!r} is in bundles {seen[r]!r} and {name!r}")
+            seen[r] = name
+    return {str(k): list(v) for k, v in doc.items()}
 
 
-def mem_mb(rule):
-    """A cluster job's memory, MB: 1.5x the recorded peak, at least 1000; 4000 for a job
-    never measured."""
-    peak = RECORDED_PEAK_MB.get(rule)
-    return 4000 if peak is None else max(1000, 100 * math.ceil(1.5 * float(peak) / 100))
+BUNDLES = _bundles()
+BUNDLED = {r for rules in BUNDLES.values() for r in rules}
+JOB_OF = {j.rule: j for j in REGISTRY.jobs}
+# what SLURM runs as one job: a bundle (its jobs' times added up) or a job outside them
+UNIT_TIMES = {**{r: t for r, t in JOB_TIMES.items() if r not in BUNDLED},
+              **{f"bundle_{b}": sum(JOB_TIMES.get(r, 0.0) for r in rules)
+                 for b, rules in BUNDLES.items()}}
+
+
+def slurm_nice(unit):
+    """The job's `sbatch --nice`: the number of SLURM jobs measured longer, times the
+    number of jobs.  The SLURM executor does not pass Snakemake's priority on; SLURM
+    starts jobs of equal priority in the order of submission, which is not this one, and
+    (priority/basic) lowers each job's priority by 1 against the one before: a step of 1
+    per place would not outweigh that."""
+    wall = UNIT_TIMES.get(unit, 0.0)
+    longer = sum(t > wall for t in UNIT_TIMES.values())
+    return f"--nice={len(UNIT_TIMES) * longer if wall else len(UNIT_TIMES) ** 2}"
+
+
+def runtime_min(*rules):
+    """A cluster job's time limit, minutes: 5x the recorded wall time of its jobs (a
+    slower node, a cold numba cache), at least 10 minutes; 60 with a job never measured."""
+    walls = [RECORDED_WALL_S.get(r) for r in rules]
+    if None in walls:
+        return 60
+    return max(10, math.ceil(5 * sum(float(w) for w in walls) / 60))
+
+
+def mem_mb(*rules):
+    """A cluster job's memory, MB: 1.5x the largest recorded peak of its jobs, at least
+    1000; 4000 with a job never measured."""
+    peaks = [RECORDED_PEAK_MB.get(r) for r in rules]
+    if None in peaks:
+        return 4000
+    return max(1000, 100 * math.ceil(1.5 * max(float(m) for m in peaks) / 100))
 
 
 localrules: all, report
@@ -329,6 +358,8 @@ rule all:
 
 
 for _job in REGISTRY.jobs:
+    if _job.rule in BUNDLED:
+        continue
     _exp = _job.experiment
 
     rule:
@@ -353,6 +384,36 @@ for _job in REGISTRY.jobs:
             section=json.dumps(config.get(_exp.name) or {}, sort_keys=True),
         shell:
             f"{THREAD_ENV} {PYTHON} -m hpfebe run {{params.rule}} --out {RESULTS} "
+            "{params.flags} 2> {log}"
+
+
+for _name, _rules in BUNDLES.items():
+    _jobs = [JOB_OF[r] for r in _rules]
+    _exps = list({j.experiment.name: j.experiment for j in _jobs}.values())
+
+    rule:
+        name: f"bundle_{_name}"
+        input:
+            sources=sorted({str(p.relative_to(workflow.basedir))
+                            for e in _exps for p in e.sources}),
+            numba=numba_input(*_exps),
+        output:
+            [p for j in _jobs for p in artefact_outputs(j.artefacts)],
+        log:
+            f"{LOGS}/bundle_{_name}.log",
+        threads: 1
+        priority: max(priority_of(r) for r in _rules)
+        resources:
+            runtime=runtime_min(*_rules),
+            mem_mb=mem_mb(*_rules),
+            slurm_extra=slurm_nice(f"bundle_{_name}"),
+        params:
+            rules=" ".join(_rules),
+            flags=config_flags(*_exps),
+            section=json.dumps({e.name: config.get(e.name) or {} for e in _exps},
+                               sort_keys=True),
+        shell:
+            f"{THREAD_ENV} {PYTHON} -m hpfebe run {{params.rules}} --out {RESULTS} "
             "{params.flags} 2> {log}"
 
 

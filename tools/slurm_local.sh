@@ -59,7 +59,8 @@ step() {
     STEP="$*"; STEP_T0=${SECONDS}
     printf '\n=== slurm_local: %s (%s) ===\n' "$*" "$(date -u +%H:%M:%S)"
 }
-die() { echo "slurm_local: FAILED: $*" >&2; exit 1; }
+FAILURE=""               # what die() said: repeated after the logs, at the end
+die() { FAILURE="$*"; echo "slurm_local: FAILED: $*" >&2; exit 1; }
 
 # ------------------------------------------------------------------ teardown (on EXIT)
 STARTED_PIDS=()          # daemons this run started, in start order (stopped in reverse)
@@ -81,9 +82,14 @@ on_exit() {
     trap - EXIT
     set +e
     if ((rc != 0)); then
+        FAILED_STEP=${STEP}
         echo "slurm_local: FAILED (exit ${rc}) in step '${STEP}'" >&2
         for f in "${WORK}"/log/slurmctld.log "${WORK}"/log/slurmd.log; do
             [[ -s "${f}" ]] && { echo "--- ${f} (last 20 lines)" >&2; tail -n 20 "${f}" >&2; }
+        done
+        find "${REPO}/results/logs" -name '*.log' -newer "${WORK}/started" 2>/dev/null \
+            | sort | while read -r f; do
+            echo "--- ${f} (last 10 lines)" >&2; tail -n 10 "${f}" >&2
         done
         if [[ -d "${REPO}/.snakemake/slurm_logs" ]]; then
             find "${REPO}/.snakemake/slurm_logs" -name '*.log' -newer "${WORK}/started" \
@@ -106,7 +112,11 @@ on_exit() {
     printf '\n=== slurm_local timings ===\n'
     printf '%s\n' "${TIMINGS[@]}"
     printf '%5d s  total\n' $((SECONDS - T0))
-    if ((rc == 0)); then echo "slurm_local: passed"; fi
+    if ((rc == 0)); then
+        echo "slurm_local: passed"
+    else
+        echo "slurm_local: FAILED (exit ${rc}) in step '${FAILED_STEP}'${FAILURE:+: ${FAILURE}}" >&2
+    fi
     exit "${rc}"
 }
 trap on_exit EXIT

@@ -104,7 +104,7 @@ def remove_stale_temporaries(out: Path, artefacts) -> list[Path]:
     if out.is_dir():
         for a in artefacts:
             stale += [p for p in out.glob(f".{a}.*.tmp") if p.is_file()]
-            stale += [p for p in out.glob(f".{a}_*.vtu") if p.is_file()]   # io.vtu.write_vtu
+            stale += [p for p in (out / "vtu").glob(f".{a}_*") if p.is_file()]  # io.vtu
     for p in stale:
         try:
             p.unlink()
@@ -310,14 +310,37 @@ def _call_run(module, exp, job, section: dict, quick: bool):
     return module.run(section, quick=quick, scenes=(job.scene,))
 
 
+def _jobs_of(registry, names) -> list:
+    """The jobs of ``names`` (artefact ids, job rules, module names) in order, each once."""
+    jobs = []
+    for name in names:
+        try:
+            found = registry.find_jobs(name)
+        except KeyError as exc:
+            raise CLIError(exc.args[0]) from None
+        jobs += [j for j in found if j not in jobs]
+    return jobs
+
+
+def _module_of(exp):
+    """The experiment module of ``exp``, checked against what the registry read."""
+    module = importlib.import_module(exp.module)
+    arts = tuple(getattr(module, "ARTEFACTS", ()))
+    if arts != exp.artefacts:
+        raise CLIError(f"{exp.path}: ARTEFACTS at import ({arts}) differs from the "
+                       f"literal read by the registry ({exp.artefacts})")
+    if not callable(getattr(module, "run", None)):
+        raise CLIError(f"{exp.path} has no function run(config, quick=False)")
+    return module
+
+
 def cmd_run(args) -> int:
+    """``hpfebe run NAME [NAME ...]``: the jobs of every name, one after another in this
+    process (a SLURM bundle runs its jobs so: one interpreter start and one set of imports
+    for all of them; profiles/slurm/bundles.yaml)."""
     root = find_root()
     registry = load_registry(root)
-    try:
-        jobs = registry.find_jobs(args.artefact)
-    except KeyError as exc:
-        raise CLIError(exc.args[0]) from None
-    exp = jobs[0].experiment
+    jobs = _jobs_of(registry, args.artefact)
 
     if args.config:
         files = [Path(f) for f in args.config]
@@ -328,7 +351,6 @@ def cmd_run(args) -> int:
     per_file = read_config_files(files)
     config = load_config(files)
     quick = check_top_level(per_file, config, [e.name for e in registry]) or args.quick
-    section = config.get(exp.name) or {}
     if args.out:
         out = Path(args.out)
     elif quick:
@@ -342,61 +364,65 @@ def cmd_run(args) -> int:
 
     matplotlib.use("Agg", force=True)  # figures are plain Figure objects (no pyplot)
 
-    from .suite import results as res
+    modules = {}
+    for job in jobs:            # every module imported and checked before any job runs
+        if job.experiment.name not in modules:
+            modules[job.experiment.name] = _module_of(job.experiment)
+    for job in jobs:
+        _run_job(job, modules[job.experiment.name], config, per_file, files, out, quick,
+                 " ".join(args.artefact), root)
+    return EXIT_OK
 
-    module = importlib.import_module(exp.module)
-    arts = tuple(getattr(module, "ARTEFACTS", ()))
-    if arts != exp.artefacts:
-        raise CLIError(f"{exp.path}: ARTEFACTS at import ({arts}) differs from the "
-                       f"literal read by the registry ({exp.artefacts})")
-    if not callable(getattr(module, "run", None)):
-        raise CLIError(f"{exp.path} has no function run(config, quick=False)")
+
+def _run_job(job, module, config, per_file, files, out, quick, asked, root) -> None:
+    """Run one job and write its artefacts (validated first, all of them)."""
+    from .suite import results as res
     from .suite.params import ConfigError
 
-    for job in jobs:
-        remove_stale_temporaries(out, job.artefacts)
-        log.info("running %s (%s) for %s%s", job.rule, ", ".join(job.artefacts),
-                 args.artefact, " [quick]" if quick else "")
-        t0 = time.perf_counter()
-        try:
-            with JitTimer() as jit:
-                results = _call_run(module, exp, job, section, quick)
-        except ConfigError as exc:
-            raise CLIError(f"config: {exc} ({where_set(per_file, exc.path)})") from None
-        wall = time.perf_counter() - t0
-        log.info("%s finished in %.1f s (numba: %.1f s compiling, %.1f s in the JIT in all)",
-                 job.rule, wall, jit.compile_s, jit.jit_s)
+    exp = job.experiment
+    section = config.get(exp.name) or {}
+    remove_stale_temporaries(out, job.artefacts)
+    log.info("running %s (%s) for %s%s", job.rule, ", ".join(job.artefacts), asked,
+             " [quick]" if quick else "")
+    t0 = time.perf_counter()
+    try:
+        with JitTimer() as jit:
+            results = _call_run(module, exp, job, section, quick)
+    except ConfigError as exc:
+        raise CLIError(f"config: {exc} ({where_set(per_file, exc.path)})") from None
+    wall = time.perf_counter() - t0
+    log.info("%s finished in %.1f s (numba: %.1f s compiling, %.1f s in the JIT in all)",
+             job.rule, wall, jit.compile_s, jit.jit_s)
 
-        if not isinstance(results, (list, tuple)) or not all(
-                isinstance(r, res.ArtefactResult) for r in results):
-            raise ValueError(f"{exp.name}.run must return a list of ArtefactResult, got "
-                             f"{type(results).__name__}")
-        names = [r.name for r in results]
-        if sorted(names) != sorted(job.artefacts):
-            what = f"scene {job.scene!r} declares" if job.scene else "ARTEFACTS declares"
-            raise ValueError(f"{exp.name}.run returned artefacts {names}, {what} "
-                             f"{list(job.artefacts)}")
-        published_dir = root / "report" / "published"
-        for r in results:  # validate everything before writing anything
-            res.validate(r)
-            _check_published(r, published_dir)
+    if not isinstance(results, (list, tuple)) or not all(
+            isinstance(r, res.ArtefactResult) for r in results):
+        raise ValueError(f"{exp.name}.run must return a list of ArtefactResult, got "
+                         f"{type(results).__name__}")
+    names = [r.name for r in results]
+    if sorted(names) != sorted(job.artefacts):
+        what = f"scene {job.scene!r} declares" if job.scene else "ARTEFACTS declares"
+        raise ValueError(f"{exp.name}.run returned artefacts {names}, {what} "
+                         f"{list(job.artefacts)}")
+    published_dir = root / "report" / "published"
+    for r in results:  # validate everything before writing anything
+        res.validate(r)
+        _check_published(r, published_dir)
 
-        run_info = {
-            "module": exp.name,
-            "job": job.rule,
-            "scene": job.scene,
-            "artefacts": list(job.artefacts),
-            "quick": quick,
-            "config_files": [str(f) for f in files],
-            "module_wall_time_s": round(wall, 3),
-            "peak_rss_mb": _peak_rss_mb(),
-            **jit.as_dict(),
-            "argv": sys.argv[1:],
-        }
-        for r in results:
-            paths = res.write_result(r, out, section, run_info=run_info)
-            log.info("wrote %s", ", ".join(str(p) for p in paths))
-    return EXIT_OK
+    run_info = {
+        "module": exp.name,
+        "job": job.rule,
+        "scene": job.scene,
+        "artefacts": list(job.artefacts),
+        "quick": quick,
+        "config_files": [str(f) for f in files],
+        "module_wall_time_s": round(wall, 3),
+        "peak_rss_mb": _peak_rss_mb(),      # of the process so far (a bundle: its jobs')
+        **jit.as_dict(),
+        "argv": sys.argv[1:],
+    }
+    for r in results:
+        paths = res.write_result(r, out, section, run_info=run_info)
+        log.info("wrote %s", ", ".join(str(p) for p in paths))
 
 
 def cmd_report(args) -> int:
@@ -454,10 +480,11 @@ def build_parser() -> argparse.ArgumentParser:
     sp.set_defaults(func=cmd_list)
 
     sp = sub.add_parser("run", help="run the scene producing ARTEFACT (writes every "
-                                    "artefact of that scene)")
-    sp.add_argument("artefact", help="artefact id, e.g. table_2_1 (see `hpfebe list`); "
-                                     "a job name (module__scene) or a module name (all its "
-                                     "scenes) works too")
+                                    "artefact of that scene); several run one after "
+                                    "another in this process")
+    sp.add_argument("artefact", nargs="+",
+                    help="artefact id, e.g. table_2_1 (see `hpfebe list`); a job name "
+                         "(module__scene) or a module name (all its scenes) works too")
     sp.add_argument("--quick", action="store_true",
                     help="CI-sized run: merge config/quick.yaml over config/config.yaml "
                          "and pass quick=True")

@@ -160,3 +160,17 @@ def test_run_names_a_job(tmp_path):
     assert reg.find_jobs(job.experiment.name) == job.experiment.jobs
     with pytest.raises(KeyError, match="unknown artefact"):
         reg.find_jobs("table_0_0")
+
+
+def test_run_several_names_one_after_another(tmp_path):
+    """`hpfebe run A B` runs both jobs in one process (a SLURM bundle's command), each
+    result with its own job in the provenance; an unknown name is refused before any job
+    runs."""
+    assert cli.main(["-q", "run", "figure_bem_laplace", "ch2_coercivity", "--quick",
+                     "--out", str(tmp_path)]) == 0
+    jobs = {a: json.loads((tmp_path / f"{a}.json").read_text())["provenance"]["run"]["job"]
+            for a in ("figure_bem_laplace", "figure_coercivity")}
+    assert jobs == {"figure_bem_laplace": "bem_laplace", "figure_coercivity": "ch2_coercivity"}
+    out = tmp_path / "refused"
+    assert cli.main(["-q", "run", "bem_laplace", "table_0_0", "--out", str(out)]) == 2
+    assert not out.exists() or not any(out.iterdir())

@@ -1,13 +1,13 @@
 """Fast checks of profiles/slurm/config.yaml (no SLURM needed; tools/slurm_local.sh runs
 the profile end to end on a single-node SLURM).
 
-Snakemake silently ignores a rule name in `groups` or `set-resources` that no rule has,
-so the names are checked against the workflow's jobs here."""
+Snakemake silently ignores a rule name in `set-resources` that no rule has, so the names
+are checked against the workflow's jobs here (the Snakefile refuses a bundle naming no
+job)."""
 
 from __future__ import annotations
 
 import dataclasses
-import math
 import re
 import sys
 from pathlib import Path
@@ -17,11 +17,17 @@ import yaml
 
 ROOT = Path(__file__).resolve().parents[2]
 PROFILE = ROOT / "profiles" / "slurm" / "config.yaml"
+BUNDLES = ROOT / "profiles" / "slurm" / "bundles.yaml"
 
 
 @pytest.fixture(scope="module")
 def profile() -> dict:
     return yaml.safe_load(PROFILE.read_text())
+
+
+@pytest.fixture(scope="module")
+def bundles() -> dict:
+    return yaml.safe_load(BUNDLES.read_text())
 
 
 @pytest.fixture(scope="module")
@@ -45,9 +51,16 @@ def test_executor_and_status_command(profile):
     assert profile["retries"] >= 1
 
 
-def test_named_rules_exist(profile, rules):
-    named = set(profile.get("groups") or {}) | set(profile.get("set-resources") or {})
+def test_named_rules_exist(profile, bundles, rules):
+    named = set(profile.get("set-resources") or {})
     assert named <= rules, f"no such rule: {sorted(named - rules)}"
+    bundled = [r for members in bundles.values() for r in members]
+    assert set(bundled) <= rules, f"no such job: {sorted(set(bundled) - rules)}"
+    assert len(bundled) == len(set(bundled)), "a job in two bundles"
+
+
+def test_profile_turns_the_bundles_on(profile):
+    assert f"bundles={BUNDLES.relative_to(ROOT)}" in profile["config"]
 
 
 def test_status_checks_capped(profile):
@@ -61,27 +74,16 @@ def test_status_checks_capped(profile):
     assert isinstance(prop, property) and prop.fset is not None
 
 
-def test_groups_run_their_jobs_one_after_another(profile):
-    """Without a per-job slot of local scope, Snakemake sizes a group job to run all its
-    jobs side by side (N CPUs, N x memory): larger than a node, it never starts."""
-    groups = profile.get("groups") or {}
-    assert set(groups.values()) == set(profile["group-components"])
-    assert profile["resources"]["hpfebe_slot"] == 1
-    assert profile["default-resources"]["hpfebe_slot"] == 1
-    assert profile["set-resource-scopes"]["hpfebe_slot"] == "local"
-
-
-def test_no_group_job_outlasts_the_longest_job(profile, recorded_wall_s):
-    """However Snakemake chunks a group into SLURM jobs of `group-components` jobs each,
-    no chunk runs longer than the longest single job (full run, config/job_times.yaml):
-    grouping never lengthens the run on a cluster with free nodes."""
-    groups = profile.get("groups") or {}
+def test_no_bundle_outlasts_the_longest_job(bundles, recorded_wall_s):
+    """A bundle runs its jobs one after another: together they take no longer than the
+    longest single job (full run, config/job_times.yaml), so bundling never lengthens the
+    run on a cluster with free nodes; the numba_cache job and the jobs outside bundles
+    stay SLURM jobs of their own."""
     longest = max(recorded_wall_s.values())
-    for name, size in profile["group-components"].items():
-        walls = sorted((recorded_wall_s[r] for r, g in groups.items() if g == name),
-                       reverse=True)
-        assert sum(walls[:size]) <= longest, (name, walls[:size], longest)
-        assert math.ceil(len(walls) / size) >= 1
+    for name, members in bundles.items():
+        assert sum(recorded_wall_s[r] for r in members) <= longest, (name, members)
+    assert not any(max(recorded_wall_s[r] for r in members) == longest
+                   for members in bundles.values())
 
 
 def test_default_resources_cover_the_measured_maxima(profile, recorded_wall_s):

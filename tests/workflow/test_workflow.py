@@ -193,6 +193,26 @@ def test_slurm_profile_dry_run(tree):
                                "(pip install -e '.[cluster]')")
     r = snakemake("-n", "--profile", "profiles/slurm", cwd=tree)
     assert r.returncode == 0, r.stdout + r.stderr
+    import yaml
+
+    bundles = yaml.safe_load((ROOT / "profiles" / "slurm" / "bundles.yaml").read_text())
+    bundled = {r for members in bundles.values() for r in members}
+    jobs = {j.rule for j in _registry_module().discover(ROOT / "experiments").jobs}
+    assert planned(r) == ({f"bundle_{b}" for b in bundles} | (jobs - bundled)
+                          | {"numba_cache", "report"})
+
+
+def test_bundle_runs_its_jobs_in_one_command(tree, tmp_path):
+    """A bundle is one rule whose one command runs its jobs one after another; a bundle
+    naming no job is refused."""
+    bundles = tmp_path / "bundles.yaml"
+    bundles.write_text("cheap: [bem_laplace, ch2_coercivity]\n")
+    r = snakemake("-n", "-p", "--config", f"bundles={bundles}", cwd=tree)
+    assert {"bundle_cheap"} <= planned(r) and not {"bem_laplace", "ch2_coercivity"} & planned(r)
+    assert "hpfebe run bem_laplace ch2_coercivity --out results" in r.stdout
+    bundles.write_text("cheap: [bem_laplace, no_such_job]\n")
+    r = snakemake("-n", "--config", f"bundles={bundles}", cwd=tree)
+    assert r.returncode != 0 and "'no_such_job', which is no job" in r.stdout + r.stderr
 
 
 # --------------------------------------------------------------------------- orphans
