@@ -162,9 +162,9 @@ if workflow.is_main_process:
 
 
 # A cluster job's Snakemake removes the job's old outputs just before it runs the job
-# (snakemake.jobs.Job.prepare).  In a SLURM job of a group, one nested Snakemake runs
-# after another, and one may start, or reach that point, after the main Snakemake was
-# killed: there it stops first (the job fails, its old outputs and log untouched; the
+# (snakemake.jobs.Job.prepare).  It may start, or reach that point, after the main
+# Snakemake was killed (a job from the queue; in a Snakemake group, `--groups`, one
+# nested Snakemake runs after another): there it stops first (the job fails, its old outputs and log untouched; the
 # profile's keep-incomplete keeps a failed job's outputs too).  The check is made at that
 # moment, not when this file is read: a job's Snakemake spends seconds between the two.
 if not workflow.is_main_process:
