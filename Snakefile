@@ -5,7 +5,7 @@
 #   snakemake -n                                   dry run: what would be (re)built
 #   snakemake --profile profiles/slurm             on a SLURM cluster
 #
-# One rule per job, generated from the registry (experiments/registry.py): a job is a
+# One rule per job, generated from the registry (hpfebe.suite.registry): a job is a
 # scene of an experiment module (rule `<module>__<scene>`) or a module without scenes
 # (rule = module name); it runs `python -m hpfebe run <rule>` and writes the artefacts of
 # that scene to results/.  What reruns a job (and then the report):
@@ -30,8 +30,8 @@ from pathlib import Path
 
 configfile: "config/config.yaml"
 
-sys.path.insert(0, workflow.basedir)
-from experiments.registry import discover, unknown_sections  # noqa: E402  (stdlib only)
+sys.path.insert(0, str(Path(workflow.basedir, "src")))   # this checkout's hpfebe
+from hpfebe.suite.registry import discover, unknown_sections  # noqa: E402  (stdlib only)
 
 
 
@@ -44,8 +44,11 @@ def discover_cached(directory):
     discover(); a nested one falls back to discover() on any mismatch or error."""
     import pickle
 
+    import hpfebe.suite.registry as registry_module
+
+    files = [p for p in directory.rglob("*.py") if "__pycache__" not in p.parts]
     stamp = repr(sorted((str(p), st.st_size, st.st_mtime_ns)
-                        for p in directory.rglob("*.py") if "__pycache__" not in p.parts
+                        for p in [*files, Path(registry_module.__file__)]
                         for st in [p.stat()]))
     cache = Path(".snakemake", "hpfebe", "registry.pickle")
     if not workflow.is_main_process:
@@ -227,7 +230,7 @@ def artefact_outputs(artefacts):
 ALL_RESULTS = [p for e in REGISTRY for p in artefact_outputs(e.artefacts)]
 
 # The numba kernels are compiled once, by the first job (`hpfebe compile`), and loaded
-# from numba's on-disk cache by every job that calls them (experiments/registry.py: a
+# from numba's on-disk cache by every job that calls them (hpfebe.suite.registry: a
 # module with NUMBA = False runs beside that job).  Without it the first two jobs of a
 # fresh machine compile the same kernels at once.  The stamp is an `ancient` input of
 # every numba job, always (an input set that depended on the state of results/ made

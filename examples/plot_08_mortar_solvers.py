@@ -21,10 +21,10 @@ pressed down onto the block body 2 (:func:`hpfebe.scenes.model_problem`).
 import matplotlib.pyplot as plt
 import numpy as np
 
-from hpfebe.scenes import model_problem
+from hpfebe.scenes import ModelProblem, model_problem
 from hpfebe.solvers import DtNSettings, GlobalUzawaSettings, SemismoothSettings, UzawaSettings
 
-problem = model_problem(n1=8, n2=6, p1=2, p2=2, F=0.1)
+problem = model_problem(ModelProblem(n1=8, n2=6, p1=2, p2=2, F=0.1))
 
 # %%
 # The three solvers; each returns a :class:`~hpfebe.contact.MortarSolution` with the

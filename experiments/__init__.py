@@ -20,7 +20,7 @@ is computed once)::
 Rules
 -----
 * ``ARTEFACTS`` is a literal tuple of strings at module level (it is read without
-  importing the module, see :mod:`experiments.registry`).  An artefact belongs to
+  importing the module, see :mod:`hpfebe.suite.registry`).  An artefact belongs to
   exactly one module.  ``table_*`` artefacts produce ``results/<id>.csv`` and
   ``.json``; ``figure_*`` artefacts must also return a figure (``results/<id>.png``).
 * ``config`` is the module's own section of ``config/config.yaml`` (key = module name);
@@ -33,7 +33,8 @@ Rules
   all results first and then writes them (:func:`hpfebe.suite.results.write_result`), so a
   contract breach never leaves half a set.  Meshes and fields for ParaView go into
   ``ArtefactResult.exports`` ({key: meshio.Mesh}, built with :mod:`hpfebe.io.vtu`) and
-  are written as ``results/<id>_<key>.vtu``.
+  are written as ``results/vtu/<id>_<key>.vtu`` ({key: [(load step, mesh), ...]}: one
+  VTU per step and a ``.pvd`` series).
 * ``table``: the published columns first, with the same names as in
   ``report/published/<published>``, then what else was measured (``dof``,
   ``wall_time_s``, iterations ...).  ``keys`` are the columns joining it with the
@@ -62,15 +63,19 @@ Rules
   Agg backend is set by the CLI; create figures with ``matplotlib.figure.Figure`` or
   ``plt.subplots`` - the CLI closes them after writing).  The patterns every experiment
   repeats are in the suite: :mod:`hpfebe.suite.figures` (``new_figure``, ``style_axes``,
-  reference slopes), :mod:`hpfebe.suite.tables` (``published_table``, ``grouped_rates``),
-  :mod:`hpfebe.suite.runs` (``select_scenes``, ``from_config_sections``, ``timed``).
+  reference slopes, ``mesh_sequence_figure``, ``deformed_field_figure``),
+  :mod:`hpfebe.suite.tables` (``published_table``, ``published_ratio``, ``grouped_rates``),
+  :mod:`hpfebe.suite.runs` (``select_scenes``, ``from_config_sections``, ``timed``).  The
+  scene itself (geometry, parameters, sweeps, the rows of the result tables, the choices
+  where the thesis is silent) lives in :mod:`hpfebe.scenes`; the experiment keeps
+  ``ARTEFACTS``/``SCENES``, ``run()``, the claims and the figures.
 
 * Scenes: a module whose artefacts come from independent computations declares them,
   ``SCENES = {"scene": ("artefact", ...), ...}``, a literal dict whose values partition
   ``ARTEFACTS``, and takes ``run(config, quick=False, scenes=None)``: it computes only
   the scenes asked for (``None``: all) and returns the results of their artefacts.  Each
   scene is one workflow job (rule ``<module>__<scene>``, see
-  :mod:`experiments.registry`); artefacts that share an expensive computation belong to
+  :mod:`hpfebe.suite.registry`); artefacts that share an expensive computation belong to
   one scene.
 
 Running: ``hpfebe run <artefact> [--quick]`` (the scene producing the artefact runs and

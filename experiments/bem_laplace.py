@@ -1,28 +1,18 @@
 """Laplace BEM on the unit square: convergence of the Neumann data (beyond the thesis).
 
 A demonstration of the whole pipeline (core -> experiment -> results -> report), not an
-artefact of the thesis.  The interior Dirichlet problem of the Laplacian on the unit
-square (0,1)^2 with the harmonic solution
-
-    u(x) = log|x - x0|,   x0 = (1.5, 1.5) outside the closed square,
-
-is solved for its Neumann data psi = du/dn through the Calderon identity of Section 1.4,
+artefact of the thesis.  The interior Dirichlet problem of the Laplacian on (0,1)^2 with
+the harmonic solution u(x) = log|x - x0|, x0 = (1.5, 1.5) outside the closed square, is
+solved for its Neumann data psi = du/dn through the Calderon identity of Section 1.4,
 V psi = (K + 1/2) u (:meth:`hpfebe.bem.LaplaceBEM.Psi`), with the Dirichlet data replaced
-by its Gauss-Lobatto interpolant in V_hp (continuous, degree p) and psi sought in W_hp
-(discontinuous Legendre, degree p - 1).  The exact Neumann data on element I with
-outward normal n_I is (x - x0) . n_I / |x - x0|^2; it jumps at the corners, which W_hp
-resolves since the corners are element ends.
-
-The choices (the thesis has no such experiment) are :data:`CHOICES`.
-
-Expected: ||psi - psi_h||_L2 = O(h^p), the best approximation order of W_hp in L2
-(the Galerkin error is O(h^(p+1/2)) in H^-1/2; the interpolated Dirichlet data
-contribute O(h^(p+1/2)) in H^-1/2 as well).
+by its Gauss-Lobatto interpolant in V_hp (degree p) and psi sought in W_hp (discontinuous,
+degree p - 1).  The exact psi = (x - x0) . n_I / |x - x0|^2 jumps at the corners, which
+are element ends.  Expected: ||psi - psi_h||_L2 = O(h^p), the best approximation order of
+W_hp in L2.  The choices (the thesis has no such experiment): :data:`CHOICES`.
 """
 
 from __future__ import annotations
 
-import logging
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -35,8 +25,6 @@ from hpfebe.suite import (ArtefactResult, from_config, joint_claim, new_figure, 
                           rate_claim, slope_line, style_axes, timed)
 
 ARTEFACTS = ("figure_bem_laplace",)
-
-log = logging.getLogger(__name__)
 
 CHOICES = (
     "L2(Gamma) error by Gauss-Legendre quadrature with p + extra_quadrature_points points "
@@ -92,7 +80,6 @@ def _sweep(p: int, ns, x0, extra) -> pd.DataFrame:
         (err, dof), seconds = timed(neumann_l2_error, p, n, x0, extra)
         rows.append(dict(p=p, n_per_side=n, h=1.0 / n, dof=dof, l2_error=err,
                          wall_time_s=seconds))
-        log.info("p=%d n=%d dof=%d error=%.3e", p, n, dof, err)
     t = pd.DataFrame(rows)
     t.insert(5, "l2_rate", observed_rates(t.h.to_numpy(), t.l2_error.to_numpy()))
     return t

@@ -16,32 +16,18 @@ from __future__ import annotations
 
 import time
 
-import numpy as np
 import pandas as pd
 from matplotlib.figure import Figure
 
-from hpfebe.scenes import interface
+from hpfebe.scenes import interface, interface_readings as rd
 from hpfebe.suite import ArtefactResult, Claim, from_config, new_figure, progress, style_axes
 
 ARTEFACTS = ("figure_coercivity",)
 
-CHOICES = (
-    "alpha = 0, h1 = edge length: the setting that reproduces the thesis's tables.",
-    "alpha = 1, 2 rows are lambda*(0) p^-alpha (exact for uniform p).",
-    "Lemma bound as printed with gamma = 2 and the computed C_inv of (2.7); young_bound = "
-    "C_inv p^(2-alpha) is the sharp version of the lemma's argument.",
-)
 ALPHAS = interface.ALPHAS        # penalty exponents p^alpha
-THESIS_LAMBDAS = (1, 5, 10)      # the lambda_Nit of Example 3
+THESIS_LAMBDAS = rd.THESIS_LAMBDAS     # the lambda_Nit of Example 3
 #: the scene's parameters (config section ch2_coercivity)
 Params = interface.CoercivityScene
-
-
-def thresholds(prm: Params) -> pd.DataFrame:
-    """lambda*, C_inv and both bounds per p and alpha on the p-sweep mesh; lambda* for
-    p = 1, 2, 3 (alpha = 0) on the other h-version meshes
-    (:func:`hpfebe.scenes.interface.coercivity_rows`)."""
-    return pd.DataFrame(interface.coercivity_rows(prm, progress))
 
 
 def _figure(main: pd.DataFrame, prm: Params) -> Figure:
@@ -60,52 +46,27 @@ def _figure(main: pd.DataFrame, prm: Params) -> Figure:
     return fig
 
 
-def _statement(a0: pd.DataFrame) -> str:
-    """Where lambda_Nit = 1, 5, 10 lie relative to lambda* (alpha = 0) for p = 1, 2, 3."""
-    lines = []
-    for p in (1, 2, 3):
-        g = a0[a0.p == p]
-        if g.empty:
-            continue
-        lo, hi = g.lambda_star.min(), g.lambda_star.max()
-        rel = ", ".join(f"lambda={v} {'above' if v > hi else 'below' if v < lo else 'at'}"
-                        for v in THESIS_LAMBDAS)
-        lines.append(f"p={p}: lambda* in [{lo:.3f}, {hi:.3f}] over meshes "
-                     f"{', '.join(g.mesh)}: {rel}")
-    return "; ".join(lines)
-
-
-def _claims(table: pd.DataFrame, main: pd.DataFrame, statement: str) -> list[Claim]:
-    a0 = table[table.alpha == 0.0]
-    g0 = main[main.alpha == 0.0].sort_values("p")
-    s1, s3 = a0[a0.p == 1].lambda_star, a0[a0.p == 3].lambda_star
+def _claims(table: pd.DataFrame, main: pd.DataFrame) -> list[Claim]:
     return [
         Claim("beyond the thesis: with alpha = 0 the threshold grows with p (like p^2)",
-              bool(np.all(np.diff(g0.lambda_star) > 0)),
-              "lambda*(p) = " + ", ".join(f"{v:.2f}" for v in g0.lambda_star),
-              kind="beyond"),
+              *rd.threshold_growth(main), kind="beyond"),
         Claim("the computed threshold respects the sufficient condition of Lemma 2.2.3",
-              bool(np.all(main.lambda_star <= main.lemma_bound)),
-              "lambda* / bound = " + ", ".join(
-                  f"{v:.2f}" for v in (main.lambda_star / main.lemma_bound)), id="lemma"),
+              *rd.lemma(main), id="lemma"),
         Claim("thesis (Example 3): the coercivity threshold lies between lambda = 1 and 5 for "
-              "p = 1 and between 5 and 10 for p = 3",
-              bool(1 < s1.min() and s1.max() < 5 and 5 < s3.min() and s3.max() < 10),
-              statement, id="example3"),
-    ]
+              "p = 1 and between 5 and 10 for p = 3", *rd.example3(table), id="example3")]
 
 
 def run(config: dict, quick: bool = False) -> list[ArtefactResult]:
     """figure_coercivity (``quick`` is unused: config/quick.yaml sets the sizes)."""
     prm = from_config(Params, config, scene="ch2_coercivity")
     t0 = time.perf_counter()
-    table = thresholds(prm)
+    table = pd.DataFrame(interface.coercivity_rows(prm, progress))
     main = table[table.mesh == f"{prm.mesh[0]}/{prm.mesh[1]}"]
-    statement = _statement(table[table.alpha == 0.0])
+    statement = rd.thresholds(table[table.alpha == 0.0])
     return [ArtefactResult(
         name="figure_coercivity", table=table, figure=_figure(main, prm),
-        claims=_claims(table, main, statement),
-        notes="Beyond the thesis. " + statement + ". " + " ".join(CHOICES)
+        claims=_claims(table, main),
+        notes="Beyond the thesis. " + statement + ". " + " ".join(interface.COERCIVITY_CHOICES)
               + " lambda* is within 1 % of young_bound: the BE part hardly helps.",
         meta=dict(run_s=round(time.perf_counter() - t0, 2),
                   allow_nan_columns=["C_inv", "young_bound", "lemma_bound"]))]

@@ -8,23 +8,20 @@ each mesh is assembled once and solved for all four lambda_Nit
 lambda = 1 does not converge for p = 1; lambda = 5 gives a reduced rate for p = 3
 (smooth); the convergence rates for lambda = 10 and 20 are almost the same, "i.e. the
 bilinear form becomes coercive"; singular: the curves do not change from lambda = 5 on.
-How each claim is decided is in :data:`CHOICES`.  Beside the sweeps, the coercivity
-threshold lambda*(p) of every mesh (:func:`hpfebe.coupling.coercivity_threshold`)
-tests whether coercivity is what separates the curves that change from those that do
-not.  The two examples are independent :data:`SCENES`.
+How each claim is decided: ``interface.LAMBDA_CHOICES`` and
+:mod:`hpfebe.scenes.interface_readings`.  Beside the sweeps, the coercivity threshold
+lambda*(p) of every mesh (:func:`hpfebe.coupling.coercivity_threshold`) tests whether
+coercivity is what separates the curves that change from those that do not.  The two
+examples are independent :data:`SCENES`.
 """
 
 from __future__ import annotations
 
-import logging
-import numpy as np
 import pandas as pd
 
-from hpfebe.scenes import interface
-from hpfebe.suite import (ArtefactResult, Claim, from_config, new_figure, readable_log_ticks,
-                          reference_slope, select_scenes, style_axes)
-
-from experiments._ch2 import rates, sweep
+from hpfebe.scenes import interface, interface_readings as rd
+from hpfebe.suite import (ArtefactResult, Claim, from_config, new_figure, progress,
+                          readable_log_ticks, reference_slope, select_scenes, style_axes)
 
 ARTEFACTS = ("figure_2_5", "figure_2_6", "figure_2_7", "figure_2_8", "figure_2_9",
              "figure_2_10", "figure_2_11", "figure_2_12")
@@ -32,61 +29,14 @@ ARTEFACTS = ("figure_2_5", "figure_2_6", "figure_2_7", "figure_2_8", "figure_2_9
 SCENES = {"smooth": ("figure_2_5", "figure_2_6", "figure_2_7", "figure_2_8"),
           "singular": ("figure_2_9", "figure_2_10", "figure_2_11", "figure_2_12")}
 
-log = logging.getLogger(__name__)
-
-CHOICES = (
-    "alpha = 0, h1 = edge length, BE-part post-processing and meshes as in "
-    "ch2_convergence.",
-    "'Does not converge': the last FE energy rate (w.r.t. h^-1) is below 0.3.",
-    "'Reduced rate': the last FE energy rate is more than 0.3 below the lambda = 20 rate, "
-    "or the BE energy rate is.",
-    "'Almost the same convergence rates' (smooth, lambda = 10 and 20): the last rates of "
-    "all four error curves of every p within 0.15 (the rate tolerance of the tables) of "
-    "lambda = 20.",
-    "'The same curves': all errors (FE and BE, L2 and energy) within 5 % of lambda = 20.",
-    "Coercivity: lambda*(p) of each mesh of the sweep (same alpha and h1) - a_h is "
-    "positive definite iff lambda_Nit > lambda*.",
-    "The lambda_Nit sweep is on the meshes up to FE h^-1 = 23 (smooth) and 64 (singular) "
-    "in the full configuration.",
-)
-SAME = 0.05            # "the same curves": all errors within 5 % of the largest lambda
-SLOWER = 0.3           # "reduced rate": last energy rate more than 0.3 lower
-RATE_TOL = 0.15        # "almost the same rates": last rates within 0.15
-ERRORS = ("fe_l2", "fe_h1", "be_l2", "be_h1")
-
 #: the scene's parameters (config section ch2_lambda)
 Params = interface.LambdaScene
 
 
-def _last_rate(df, part, x, norm="h1"):
-    g = df.sort_values(x)
-    return float(rates(g[x], g[f"{part}_{norm}"])[-1])
-
-
-def _max_rel_diff(a, b, cols=ERRORS):
-    """Largest |a/b - 1| over the error columns (rows matched by position)."""
-    r = np.concatenate([(a[c].to_numpy() / b[c].to_numpy()) for c in cols])
-    return float(np.max(np.abs(r - 1.0)))
-
-
-def thresholds(prm: Params, example: str, cases) -> pd.DataFrame:
-    """lambda*(p) (coercivity threshold, Lemma 2.2.3) of every (fe_h_inv, be_h_inv, p) of
-    ``cases``, with the sweep's alpha and h1 (:func:`.interface.threshold_rows`)."""
-    return pd.DataFrame(interface.threshold_rows(prm, example, cases))
-
-
-def _deviations(d, ref, star) -> pd.DataFrame:
-    """Per mesh and p: the largest |e / e_ref - 1| over the four errors against the
-    reference lambda, and lambda* of that mesh."""
-    key = ["series", "p", "fe_h_inv", "be_h_inv"]
-    m = d.merge(ref, on=key, suffixes=("", "_ref")).merge(star, on=key)
-    dev = np.max([np.abs(m[c] / m[f"{c}_ref"] - 1.0) for c in ERRORS], axis=0)
-    return m[key + ["lambda_nit", "lambda_star"]].assign(dev=dev)
-
-
-def _points(df) -> str:
-    return ", ".join(f"{r.series}-version p={r.p} FE 1/{r.fe_h_inv:g}: {r.dev:.1%} "
-                     f"(lambda* {r.lambda_star:.2f})" for r in df.itertuples()) or "none"
+def _sweep(prm: Params, name: str, series: str, cases, desc: str) -> pd.DataFrame:
+    """One row per (case, lambda_Nit) (:func:`hpfebe.scenes.interface.sweep_rows`)."""
+    return pd.DataFrame(interface.sweep_rows(name, series, cases, prm.lambdas, prm.alpha,
+                                             prm.h_def, desc, False, progress))
 
 
 #: line styles of the four error curves: (part, norm) -> (label, marker, linestyle)
@@ -99,58 +49,20 @@ STYLES = {("fe", "h1"): ("energy-err (FE)", "o", "-"),
 # ----------------------------------------------------------------------------- smooth
 def _smooth_claims(lambda_nit, d, ref, degrees, star) -> list[Claim]:
     if lambda_nit == 1.0:
-        g = d[d.p == 1].sort_values("fe_h_inv")
-        r = _last_rate(g, "fe", "fe_h_inv")
-        return [Claim("lambda_Nit = 1: no convergence for p = 1", bool(r < SLOWER),
-                      f"last FE energy rate {r:.2f}; FE energy errors p=1: "
-                      + ", ".join(f"{v:.3e}" for v in g.fe_h1), id="no_convergence")]
+        return [Claim("lambda_Nit = 1: no convergence for p = 1", *rd.no_convergence(d),
+                      id="no_convergence")]
     if lambda_nit == 5.0 and 3 in degrees:
-        g, g20 = d[d.p == 3], ref[ref.p == 3]
-        rf, rf20 = _last_rate(g, "fe", "fe_h_inv"), _last_rate(g20, "fe", "fe_h_inv")
-        rb, rb20 = _last_rate(g, "be", "be_h_inv"), _last_rate(g20, "be", "be_h_inv")
-        s3 = star[star.p == 3].lambda_star
-        return [Claim(
-            "lambda_Nit = 5: reduced convergence rate for p = 3",
-            bool((rf < rf20 - SLOWER) or (rb < rb20 - SLOWER)),
-            f"last energy rates p=3: FE {rf:.2f} (lambda=20: {rf20:.2f}), BE {rb:.2f} "
-            f"(lambda=20: {rb20:.2f}); largest deviation from lambda=20 "
-            f"{_max_rel_diff(g, g20):.1%}", id="reduced_p3"),
-            Claim(
-            "beyond the thesis: lambda_Nit = 5 is below the coercivity threshold "
-            "lambda*(3) on every mesh of the sweep, and the p = 3 rates are nevertheless "
-            "those of lambda_Nit = 20",
-            bool((s3 > lambda_nit).all() and abs(rf - rf20) <= RATE_TOL
-                 and abs(rb - rb20) <= RATE_TOL),
-            f"lambda*(3) = {s3.min():.2f}..{s3.max():.2f} over the meshes FE h^-1 = "
-            + ", ".join(f"{v:g}" for v in star[star.p == 3].fe_h_inv)
-            + f"; last energy rates FE {rf:.2f} / {rf20:.2f}, BE {rb:.2f} / {rb20:.2f} "
-              "(lambda = 5 / 20)", kind="beyond")]
+        return [Claim("lambda_Nit = 5: reduced convergence rate for p = 3",
+                      *rd.reduced_p3(d, ref), id="reduced_p3"),
+                Claim("beyond the thesis: lambda_Nit = 5 is below the coercivity threshold "
+                      "lambda*(3) on every mesh of the sweep, and the p = 3 rates are "
+                      "nevertheless those of lambda_Nit = 20",
+                      *rd.below_threshold(d, ref, star, lambda_nit), kind="beyond")]
     if lambda_nit == 10.0:
-        diff = {p: max(abs(_last_rate(d[d.p == p], part, h, norm)
-                           - _last_rate(ref[ref.p == p], part, h, norm))
-                       for part, h in (("fe", "fe_h_inv"), ("be", "be_h_inv"))
-                       for norm in ("h1", "l2")) for p in degrees}
-        devs = {p: _max_rel_diff(d[d.p == p].sort_values("fe_h_inv"),
-                                 ref[ref.p == p].sort_values("fe_h_inv")) for p in degrees}
-        dv = _deviations(d, ref, star)
-        finest = dv[dv.fe_h_inv == dv.fe_h_inv.max()]
-        worst = dv.loc[[dv.dev.idxmax()]]
-        below = dv[dv.lambda_nit < dv.lambda_star]
-        return [Claim(
-            "lambda_Nit = 10 and 20 give almost the same convergence rates",
-            bool(max(diff.values()) <= RATE_TOL),
-            "largest difference of the last rates (FE/BE, L2/energy) to lambda = 20: "
-            + ", ".join(f"p={p}: {v:.3f}" for p, v in diff.items())
-            + f" (tolerance {RATE_TOL})", id="same_rates"),
-            Claim(
-            "beyond the thesis: lambda_Nit = 10 and 20 give the same errors (within 5 %)",
-            bool(max(devs.values()) <= SAME),
-            "largest relative difference of the errors to lambda = 20: " + ", ".join(
-                f"p={p}: {v:.1%}" for p, v in devs.items()) + "; on the finest mesh: "
-            + ", ".join(f"p={r.p}: {r.dev:.1%}" for r in finest.itertuples())
-            + ". Largest: " + _points(worst) + "; meshes where lambda = 10 is "
-            "below lambda*: " + _points(below) + " (coercivity does not single out the "
-            "largest difference)", kind="beyond")]
+        return [Claim("lambda_Nit = 10 and 20 give almost the same convergence rates",
+                      *rd.same_rates(d, ref, degrees), id="same_rates"),
+                Claim("beyond the thesis: lambda_Nit = 10 and 20 give the same errors "
+                      "(within 5 %)", *rd.same_errors(d, ref, star, degrees), kind="beyond")]
     return []
 
 
@@ -171,7 +83,7 @@ def _per_lambda(prm: Params, df: pd.DataFrame, first: int, title: str, xlabel: s
             name=f"figure_2_{first + k}", table=d.reset_index(drop=True), figure=fig,
             claims=claims(lambda_nit, d, ref),
             meta=dict(meta, alpha=prm.alpha, h_def=prm.h_def, lambdas=list(prm.lambdas)),
-            notes=notes + " Choices: " + " ".join(CHOICES)))
+            notes=notes + " Choices: " + " ".join(interface.LAMBDA_CHOICES)))
     return out
 
 
@@ -184,9 +96,8 @@ def _star_meta(star: pd.DataFrame) -> dict:
 def smooth_figures(prm: Params) -> list[ArtefactResult]:
     """Figures 2.5-2.8: Example 1, h-version, errors against 1/h, one lambda_Nit each."""
     cases = [(fh, bh, p) for p in prm.degrees for fh, bh in prm.smooth_pairs]
-    sm = sweep("smooth", "h", cases, lambdas=prm.lambdas, alpha=prm.alpha, h_def=prm.h_def,
-               desc="smooth lambda sweep")
-    star = thresholds(prm, "smooth", cases).assign(series="h")
+    sm = _sweep(prm, "smooth", "h", cases, "smooth lambda sweep")
+    star = pd.DataFrame(interface.threshold_rows(prm, "smooth", cases)).assign(series="h")
     colours = {p: f"C{k}" for k, p in enumerate(prm.degrees)}
 
     def draw(ax, d):
@@ -208,59 +119,33 @@ def smooth_figures(prm: Params) -> list[ArtefactResult]:
 
 # ----------------------------------------------------------------------------- singular
 def _singular_claims(lambda_nit, d, sref, star) -> list[Claim]:
-    key = ["series", "p", "dof"]
-    lam_max = sref.lambda_nit.iloc[0]
-    if lambda_nit >= 5.0:
-        text = (f"singular: lambda_Nit = {lambda_nit:g} gives the same curves as larger "
-                "lambda (unchanged from lambda = 5 on)")
-        if lambda_nit >= lam_max:
-            return [Claim(text, None, f"lambda_Nit = {lambda_nit:g} is the largest value of "
-                                      "the sweep: there is no larger one to compare with",
-                          id="same_curves")]
-        dh = _max_rel_diff(d[d.series == "h"].sort_values(key),
-                           sref[sref.series == "h"].sort_values(key))
-        dp = {p: _max_rel_diff(d[(d.series == "p") & (d.p == p)],
-                               sref[(sref.series == "p") & (sref.p == p)])
-              for p in sorted(d[d.series == "p"].p.unique())}
-        same = Claim(text, bool(max([dh] + list(dp.values())) <= SAME),
-                     f"largest relative difference to lambda = {lam_max:g}: h-version "
-                     f"{dh:.1%}; p-version " + ", ".join(f"p={p}: {v:.1%}"
-                                                         for p, v in dp.items()),
-                     id="same_curves")
-        if same.holds:
-            return [same]
-        dv = _deviations(d, sref, star)
-        changed = dv[dv.dev > SAME]
-        coercive_changed = changed[changed.lambda_nit > changed.lambda_star]
-        below_same = dv[(dv.lambda_nit < dv.lambda_star) & (dv.dev <= SAME)]
-        worst = dv.loc[[dv.dev.idxmax()]]
-        return [same, Claim(
-            f"the curves change (by more than {SAME:.0%}) only where lambda_Nit = "
-            f"{lambda_nit:g} is below the coercivity threshold lambda*(p) of the mesh, so "
-            "that a_h is not coercive there",
-            bool(coercive_changed.empty),
-            f"{len(changed)} of {len(dv)} points change; changed although lambda_Nit > "
-            f"lambda*: {_points(coercive_changed)}; lambda_Nit < lambda* but unchanged: "
-            f"{_points(below_same)}; the largest change: {_points(worst)}. Coercivity "
-            "(computed on the same meshes, same alpha and h1) does not separate the curves "
-            "that change from those that do not.",
-            kind="explanation", id="coercivity", explains=("same_curves",))]
-    dev = _max_rel_diff(d.sort_values(key), sref.sort_values(key))
-    return [Claim("singular: lambda_Nit = 1 differs from the larger values", bool(dev > SAME),
-                  f"largest relative difference to lambda = {lam_max:g}: {dev:.2%}",
-                  id="differs")]
+    if lambda_nit < 5.0:
+        return [Claim("singular: lambda_Nit = 1 differs from the larger values",
+                      *rd.differs(d, sref), id="differs")]
+    text = (f"singular: lambda_Nit = {lambda_nit:g} gives the same curves as larger "
+            "lambda (unchanged from lambda = 5 on)")
+    if lambda_nit >= sref.lambda_nit.iloc[0]:
+        return [Claim(text, None, f"lambda_Nit = {lambda_nit:g} is the largest value of "
+                                  "the sweep: there is no larger one to compare with",
+                      id="same_curves")]
+    same = Claim(text, *rd.same_curves(d, sref), id="same_curves")
+    return [same] if same.holds else [same, Claim(
+        f"the curves change (by more than {rd.SAME:.0%}) only where lambda_Nit = "
+        f"{lambda_nit:g} is below the coercivity threshold lambda*(p) of the mesh, so "
+        "that a_h is not coercive there", *rd.coercivity(d, sref, star),
+        kind="explanation", id="coercivity", explains=("same_curves",))]
 
 
 def singular_figures(prm: Params) -> list[ArtefactResult]:
     """Figures 2.9-2.12: Example 2, h- and p-version, errors against DOF."""
-    kw = dict(lambdas=prm.lambdas, alpha=prm.alpha, h_def=prm.h_def)
     qf, qb = prm.singular_p_mesh
     cases = {"h": [(fh, bh, 1) for fh, bh in prm.singular_pairs],
              "p": [(qf, qb, p) for p in prm.singular_p_degrees]}
-    sg = pd.concat([sweep("singular", series, c, desc=f"singular {series} lambda sweep", **kw)
+    sg = pd.concat([_sweep(prm, "singular", series, c, f"singular {series} lambda sweep")
                     for series, c in cases.items()], ignore_index=True)
-    star = pd.concat([thresholds(prm, "singular", c).assign(series=series)
-                      for series, c in cases.items()], ignore_index=True)
+    star = pd.concat([pd.DataFrame(interface.threshold_rows(prm, "singular", c))
+                      .assign(series=series) for series, c in cases.items()],
+                     ignore_index=True)
     colours = {k: f"C{i}" for i, k in enumerate(STYLES)}
 
     def draw(ax, d):

@@ -37,7 +37,7 @@ ROOT = Path(__file__).resolve().parents[1]
 
 #: the layers of DESIGN.md ("The core, as data flows through it"), bottom first; the root
 #: ``hpfebe`` (its lazy curated API reaches every layer) sits on top with the CLI
-LAYERS = (("checks",), ("geometry", "quadrature"), ("spaces",), ("constitutive",), ("solvers",), ("bem",),
+LAYERS = (("_numba_cache", "checks"), ("geometry", "quadrature"), ("spaces",), ("constitutive",), ("solvers",), ("bem",),
           ("fem",), ("analysis",), ("bodies",), ("coupling",), ("contact",), ("adaptivity",),
           ("io",), ("scenes",), ("suite",), ("cli", "__main__", "hpfebe"))
 PKG = ROOT / "src" / "hpfebe"

@@ -30,17 +30,21 @@ Artefacts:
   Tresca and Coulomb friction: iterations, wall time, mutual differences, and a
   work-precision plot (error against wall time over a tolerance sweep).
 
-The choices where the thesis is silent, the parameters and the model problem
-(:mod:`hpfebe.scenes.mortar`): :mod:`.scene`; the artefacts: :mod:`.table`, :mod:`.uzawa`.
+The model problem: :mod:`hpfebe.scenes.mortar`; its parameters, the choices where the
+thesis is silent, the published numbers and the runs: :mod:`hpfebe.scenes.mortar_runs`;
+what the claims rest on: :mod:`hpfebe.scenes.mortar_readings`; the artefacts:
+:mod:`.table`, :mod:`.uzawa`.  ParaView files (``exports``, both boundaries with U and
+the contact state along Gamma^1_C): Figure 4.17's, 4.18's finest and 4.19's solutions,
+and the semismooth Newton reference of the solver comparison (Coulomb).
 """
 
 from __future__ import annotations
 
 import dataclasses
 
+from hpfebe.scenes import mortar_runs as mr
 from hpfebe.suite import ArtefactResult, from_config, select_scenes, timed
 
-from .scene import QUICK_ADAPT, Params, _problem
 from .table import (convergence_sweep, damping_sweep, figure_4_17, figure_4_18,
                     figure_dtn_map, table_4_1)
 from .uzawa import figure_4_19, figure_4_20, figure_solver_comparison, figure_uzawa_rho
@@ -56,13 +60,13 @@ SCENES = {"table": ("table_4_1", "figure_4_17"), "sweep": ("figure_4_18",),
           "beyond": ("figure_dtn_map", "figure_solver_comparison")}
 
 
-def _table_problem(prm: Params):
+def _table_problem(prm: mr.MortarScene):
     """The Table 4.1 problem (p = table_p on the table_n meshes), shared by the DtN
     artefacts on that mesh, and its set-up time."""
-    return timed(_problem, prm, prm.table_n[0], prm.table_n[1], prm.table_p, prm.table_p)
+    return timed(prm.problem, prm.table_n[0], prm.table_n[1], prm.table_p, prm.table_p)
 
 
-def _scene_table(prm: Params, table) -> list[ArtefactResult]:
+def _scene_table(prm: mr.MortarScene, table) -> list[ArtefactResult]:
     pr, setup = table
     df, best = damping_sweep(prm, pr)
     if best is None:
@@ -74,7 +78,7 @@ def _scene_table(prm: Params, table) -> list[ArtefactResult]:
 #: ``table`` = (problem, set-up time) of :func:`_table_problem` (assembled once per run)
 _SCENE_RUNS = {
     "table": (_scene_table, True),
-    "sweep": (lambda prm, _: [figure_4_18(prm, convergence_sweep(prm))], False),
+    "sweep": (lambda prm, _: [figure_4_18(prm, *convergence_sweep(prm))], False),
     "uzawa": (lambda prm, _: [figure_4_19(prm), figure_4_20(prm), figure_uzawa_rho(prm)],
               False),
     "beyond": (lambda prm, table: [figure_dtn_map(prm, table[0]),
@@ -83,9 +87,10 @@ _SCENE_RUNS = {
 
 def run(config: dict, quick: bool = False, scenes=None) -> list[ArtefactResult]:
     """scenes: names of :data:`SCENES` to compute (None: all)."""
-    prm = from_config(Params, config, "ch4_mortar")
+    prm = from_config(mr.MortarScene, config, "ch4_mortar")
     if quick and "adapt_steps" not in (config or {}):
-        prm = dataclasses.replace(prm, adapt_steps=QUICK_ADAPT[0], adapt_show=QUICK_ADAPT[1])
+        prm = dataclasses.replace(prm, adapt_steps=mr.QUICK_ADAPT[0],
+                                  adapt_show=mr.QUICK_ADAPT[1])
     table, out = None, []
     for name in select_scenes(SCENES, scenes, "ch4_mortar"):     # in the order of SCENES
         f, on_table_mesh = _SCENE_RUNS[name]

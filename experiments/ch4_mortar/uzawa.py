@@ -10,16 +10,15 @@ import numpy as np
 import pandas as pd
 from matplotlib.figure import Figure
 
-from hpfebe.constitutive import lame_constants
-from hpfebe.scenes import adaptive_model_problem
-from hpfebe.solvers import SemismoothSettings
+from hpfebe.scenes import ModelProblem, adaptive_model_problem
+from hpfebe.scenes import mortar, mortar_readings as rd
+from hpfebe.scenes import mortar_runs as mr
 from hpfebe.suite import ArtefactResult, Claim, new_figure, progress, style_axes, timed
 
-from .scene import CHOICES, Params, _dof, _dtn_settings, _global_settings, _problem
 from .table import _plot_bodies
 
 
-def _plot_4_19(prm: Params, pr, sol) -> Figure:
+def _plot_4_19(prm: mr.MortarScene, pr, sol) -> Figure:
     """Figure 4.19: the deformed bodies, a zoom on Gamma_C (where the gap closes) and the
     contact tractions against x."""
     pn, pt = sol.extra["pn"], sol.extra["pt"]
@@ -51,11 +50,11 @@ def _plot_4_19(prm: Params, pr, sol) -> Figure:
     return fig
 
 
-def figure_4_19(prm: Params) -> ArtefactResult:
+def figure_4_19(prm: mr.MortarScene) -> ArtefactResult:
     n1, n2 = prm.coulomb_n
     bems = {}                        # the BE bodies, shared with the gap-free reading
-    pr, setup_s = timed(_problem, prm, n1, n2, 2, 2, bems)
-    sol, solve_s = timed(pr.global_uzawa, _global_settings(prm))
+    pr, setup_s = timed(prm.problem, n1, n2, 2, 2, bems)
+    sol, solve_s = timed(pr.global_uzawa, prm.global_settings())
     run_s = setup_s + solve_s
     pn, pt = sol.extra["pn"], sol.extra["pt"]
     order = np.argsort(pr.points[:, 0])
@@ -66,83 +65,24 @@ def figure_4_19(prm: Params) -> ArtefactResult:
     claims = [Claim("normal contact traction reaches about 8e4 (the thesis's axis)",
                     bool(4e4 <= peak <= 1.2e5), f"our peak {peak:.4g} "
                     f"(ratio {peak / 8e4:.3f} to 8e4)", id="peak"),
-              _traction_claim(prm, pr, sol, bems),
-              _gapless_claim(prm, pn, bems),
+              Claim("the thesis's traction axis (8e4) does not fit E, nu and U = (0, -0.09): "
+                    "the contact force is fixed by the prescribed displacement (our resultant "
+                    "agrees with a one-dimensional estimate within a factor 2 on two meshes), "
+                    "and a traction peaking at 8e4 would carry more than twice that force",
+                    *rd.traction(prm, pr, sol, bems), kind="explanation", id="force",
+                    explains=("peak",)),
+              Claim("(other reading) Algorithm 4.5's step 3 as printed, U^1 - B^-1 D U^2 "
+                    "without the initial gap: a corner traction on the scale of the thesis's "
+                    "axis (8e4)", *rd.gap_free(prm, pn, bems), kind="hypothesis",
+                    id="gap_free", explains=("peak",)),
               Claim("global Uzawa (Algorithm 4.5) converges", bool(sol.info.converged),
                     f"{sol.info.reason} after {sol.info.iterations} iterations, rho = "
                     f"{sol.info.counts.get('rho', np.nan):.4g}", id="converges")]
     return ArtefactResult("figure_4_19", table, figure=fig, claims=claims,
-                          notes=" ".join(CHOICES),
+                          notes=" ".join(mr.CHOICES),
                           meta=dict(run_s=run_s, iterations=sol.info.iterations,
-                                    dof=_dof(pr), peak_pn=peak))
-
-
-def _traction_claim(prm: Params, pr, sol, bems: dict) -> Claim:
-    """Evidence on the traction scale: the resultant contact force (equilibrium) beside
-    a one-dimensional estimate (body 1 in uniaxial plane strain, modulus E', in series
-    with the laterally confined body 2, modulus lambda + 2 mu, both of height 2, width
-    2, the gap ignored), on the figure's mesh and on the mesh with half as many elements
-    (the force must not depend on h).  ``bems``: the BE bodies' cache."""
-    lam, mu = lame_constants(prm.E, prm.nu, prm.plane)
-    E1 = 4.0 * mu * (lam + mu) / (lam + 2.0 * mu)
-    est = 2.0 * abs(prm.u_top) / (2.0 / E1 + 2.0 / (lam + 2.0 * mu))
-    n1, n2 = (max(1, n // 2) for n in prm.coulomb_n)
-    pr_h = _problem(prm, n1, n2, 2, 2, bems)
-    sol_h = pr_h.global_uzawa(_global_settings(prm))
-    tests, rows = [], []
-    for q, s, mesh in ((pr, sol, prm.coulomb_n), (pr_h, sol_h, (n1, n2))):
-        pn, pt = s.extra["pn"], s.extra["pt"]
-        Fy = abs(float(np.sum(q.w * (pn * q.n[:, 1] + pt * q.t[:, 1]))))
-        width = float(np.ptp(q.points[pn > 1e-8 * pn.max(), 0]))
-        scaled = Fy * 8e4 / pn.max()   # our profile scaled to the thesis's peak
-        tests.append(s.info.converged and 0.5 <= Fy / est <= 2.0 and scaled > 2.0 * est)
-        rows.append(f"h1:h2 = {mesh[0]}:{mesh[1]}: resultant vertical contact force on body "
-                    f"1 {Fy:.4g} over a contact width {width:.3f} (mean pressure "
-                    f"{Fy / max(width, 1e-12):.4g}, peak {pn.max():.4g}), the profile scaled "
-                    f"to the peak 8e4 carries {scaled:.4g} ({scaled / est:.1f} x the estimate)")
-    return Claim(
-        "the thesis's traction axis (8e4) does not fit E, nu and U = (0, -0.09): the "
-        "contact force is fixed by the prescribed displacement (our resultant agrees with "
-        "a one-dimensional estimate within a factor 2 on two meshes), and a traction "
-        "peaking at 8e4 would carry more than twice that force", bool(all(tests)),
-        "; ".join(rows) + f". One-dimensional estimate (E' = {E1:.4g} in series with "
-        f"lambda + 2 mu = {lam + 2 * mu:.4g}, gap ignored) {est:.4g}. Readings "
-        "tested (h1:h2 = 41:25 as element counts or as sizes, plane stress, Gamma^2_D = "
-        "{-1,1} x [-1,0], flat Gamma_C) give peaks 9.9e3 - 1.09e4; nodal forces (P "
-        "times the Gauss-Lobatto weights) peak at 3.5e2. The one reading that reaches the "
-        "axis is the gap-free step 3 (next claim).", kind="explanation", id="force",
-        explains=("peak",))
-
-
-def _gapless_claim(prm: Params, pn_ours: np.ndarray, bems: dict) -> Claim:
-    """Algorithm 4.5, step 3, as printed: P <- Pi_M(P - rho (U^1 - B^-1 D U^2)), without
-    the initial gap g.  The arc is then pressed flat onto Gamma^2_C and the traction is
-    singular at the corners x = +-1 (where Gamma^2_C meets body 2's Dirichlet sides):
-    solved on the figure's mesh and on the mesh with half as many elements, to show that
-    the corner peak depends on h while the interior traction does not.  ``bems``: the
-    figure's BE bodies (assembled once, :func:`model_problem`'s cache)."""
-    rows, peak = [], np.nan
-    for k in (2, 1):                 # k = 1 (last): the figure's mesh
-        n1, n2 = (max(1, n // k) for n in prm.coulomb_n)
-        pr = _problem(prm, n1, n2, 2, 2, bems, gap=lambda x: np.zeros(len(x)))
-        sol = pr.global_uzawa(_global_settings(prm))
-        pn, x = sol.extra["pn"], pr.points[:, 0]
-        inner = np.abs(x) <= 0.9
-        peak = float(pn.max()) if sol.info.converged else np.nan
-        rows.append(f"h1:h2 = {n1}:{n2}: {sol.info.reason}, corner peak {pn.max():.3g} at "
-                    f"x = {x[np.argmax(pn)]:+.2f}, |x| <= 0.9: {pn[inner].min():.3g} - "
-                    f"{pn[inner].max():.3g}")
-    return Claim(
-        "(other reading) Algorithm 4.5's step 3 as printed, U^1 - B^-1 D U^2 without the "
-        "initial gap: a corner traction on the scale of the thesis's axis (8e4)",
-        None if np.isnan(peak) else bool(4e4 <= peak <= 1.2e5),
-        "; ".join(rows) + f". With the gap (our figure) the peak is {pn_ours.max():.3g} "
-        "near x = 0. Without it the traction is singular at x = +-1, so its peak grows "
-        "under refinement and its printed height says nothing about the solution; the "
-        "thesis's axis (ticks 0 - 80000) is reached only by such a corner value. "
-        "Our figure keeps the gap (the model problem of Section 4.3.4 starts with the arc "
-        "touching at one point); the thesis's plot cannot be read to decide.",
-        kind="hypothesis", id="gap_free", explains=("peak",))
+                                    dof=mr.dof(pr), peak_pn=peak),
+                          exports=mortar.mortar_exports(pr, sol))
 
 
 def _plot_hp_mesh(ax, meshes, title):
@@ -163,20 +103,13 @@ def _plot_hp_mesh(ax, meshes, title):
     ax.set_title(title, fontsize=9)
 
 
-def figure_4_20(prm: Params) -> ArtefactResult:
+def figure_4_20(prm: mr.MortarScene) -> ArtefactResult:
+    start = ModelProblem(*prm.adapt_n, prm.adapt_p, prm.adapt_p, prm.E, prm.nu, prm.F,
+                         (0.0, prm.u_top), prm.radius, prm.plane)
     (hist, counts), run_s = timed(            # Algorithm 4.6 on both bodies
-        adaptive_model_problem, _global_settings(prm), prm.adapt_steps + 1, prm.adapt_n,
-        prm.adapt_p, (prm.adapt_q1, prm.adapt_q2), prm.radius, E=prm.E, nu=prm.nu, F=prm.F,
-        u_top=(0.0, prm.u_top), plane=prm.plane)
-    rows = []
-    for rec, meshes in zip(hist.records, hist.meshes):
-        rows.append(dict(step=rec["step"], dof_1=rec["ndof"][0], dof_2=rec["ndof"][1],
-                         eta_1=rec["eta"][0], eta_2=rec["eta"][1], eta=rec["eta_total"],
-                         elements_1=meshes[0].n_elements, elements_2=meshes[1].n_elements,
-                         p_max_1=int(meshes[0].degrees.max()),
-                         p_max_2=int(meshes[1].degrees.max()),
-                         n_marked_1=rec["n_marked"][0], n_marked_2=rec["n_marked"][1]))
-    df = pd.DataFrame(rows)
+        adaptive_model_problem, prm.global_settings(), prm.adapt_steps + 1, start,
+        (prm.adapt_q1, prm.adapt_q2))
+    df = pd.DataFrame(mr.adaptive_rows(hist))
     show = [k for k in prm.adapt_show if k < len(hist.meshes)]
     fig, axes = new_figure((4 * (len(show) + 1), 5), 1, len(show) + 1)
     axes = np.atleast_1d(axes)
@@ -194,26 +127,17 @@ def figure_4_20(prm: Params) -> ArtefactResult:
                     f"eta {df['eta'].iloc[0]:.4g} -> {df['eta'].iloc[-1]:.4g} (the thesis "
                     "shows the meshes only)", kind="beyond")]
     return ArtefactResult("figure_4_20", df, figure=fig, claims=claims,
-                          notes=" ".join(CHOICES), meta=dict(run_s=run_s, n_h=n_h, n_p=n_p))
+                          notes=" ".join(mr.CHOICES), meta=dict(run_s=run_s, n_h=n_h, n_p=n_p))
 
 
-def figure_uzawa_rho(prm: Params) -> ArtefactResult:
+def figure_uzawa_rho(prm: mr.MortarScene) -> ArtefactResult:
     """Global Uzawa iterations against rho / rho_crit (beyond the thesis): the predicted
     bound rho < rho_crit of Theorem 3.1.8 (linear response, largest eigenvalue) against
     the largest convergent step measured."""
     t = time.perf_counter()
-    pr = _problem(prm, prm.rho_n[0], prm.rho_n[1], 2, 2)
-    rows = []
-    for law in ("tresca", "coulomb"):
-        for r in progress(prm.rho_ratios, desc=f"figure_uzawa_rho {law}"):
-            sol = pr.global_uzawa(_global_settings(prm, friction=law, rho=2.0 * r,
-                                                   max_iter=prm.max_rho_iter))
-            rows.append(dict(friction=law, rho_over_crit=float(r),
-                             rho=float(sol.info.counts["rho"]),
-                             rho_crit=float(sol.info.counts["rho_crit"]),
-                             iterations=sol.info.iterations, converged=sol.info.converged,
-                             reason=sol.info.reason))
-    df = pd.DataFrame(rows)
+    pr = prm.problem(prm.rho_n[0], prm.rho_n[1], 2, 2)
+    df = pd.DataFrame([mr.rho_row(prm, pr, law, r) for law in ("tresca", "coulomb")
+                       for r in progress(prm.rho_ratios, desc=f"figure_uzawa_rho {law}")])
     fig, ax = new_figure((6, 4.5))
     for law, g in df.groupby("friction"):
         ok = g[g["converged"]]
@@ -233,17 +157,7 @@ def figure_uzawa_rho(prm: Params) -> ArtefactResult:
                     "tangential part projected to +-F the relevant operator is smaller)",
                     kind="beyond")]
     return ArtefactResult("figure_uzawa_rho", df, figure=fig, claims=claims,
-                          notes=" ".join(CHOICES), meta=dict(run_s=time.perf_counter() - t))
-
-
-def _timed(f, repeats: int = 3):
-    """f() and its wall time, the minimum of ``repeats`` calls (single calls of ~1 ms
-    scatter by tens of per cent)."""
-    walls = []
-    for _ in range(repeats):
-        sol, wall = timed(f)
-        walls.append(wall)
-    return sol, min(walls)
+                          notes=" ".join(mr.CHOICES), meta=dict(run_s=time.perf_counter() - t))
 
 
 def _plot_solver_comparison(df: pd.DataFrame) -> Figure:
@@ -277,28 +191,11 @@ def _plot_solver_comparison(df: pd.DataFrame) -> Figure:
     return fig
 
 
-def figure_solver_comparison(prm: Params, pr) -> ArtefactResult:
+def figure_solver_comparison(prm: mr.MortarScene, pr) -> ArtefactResult:
     """The three solvers on one discrete problem (beyond the thesis)."""
     t0 = time.perf_counter()
-    rows = []
-    for law in ("tresca", "coulomb"):
-        ref = pr.semismooth_newton(SemismoothSettings(tol=1e-13, friction=law, mu_f=prm.mu_f))
-        scale = max(np.abs(ref.U1).max(), np.abs(ref.U2).max())
-        runs = {
-            "semismooth Newton": lambda tol: pr.semismooth_newton(
-                SemismoothSettings(tol=tol, friction=law, mu_f=prm.mu_f)),
-            "global Uzawa": lambda tol: pr.global_uzawa(
-                _global_settings(prm, friction=law, tol=tol))}
-        if law == "tresca":
-            runs["DtN + Uzawa"] = lambda tol: pr.dtn(_dtn_settings(
-                prm, *prm.conv_omega, tol=tol, tol_U=min(tol, prm.tol_uzawa)))
-        for name, f in runs.items():
-            for tol in prm.compare_tols:
-                sol, wall = _timed(lambda: f(tol))
-                err = max(np.abs(sol.U1 - ref.U1).max(), np.abs(sol.U2 - ref.U2).max()) / scale
-                rows.append(dict(friction=law, method=name, tol=tol, iterations=sol.info.iterations,
-                                 converged=sol.info.converged, wall_time_s=wall,
-                                 rel_difference=err, reason=sol.info.reason))
+    runs = {law: mr.solver_rows(prm, pr, law) for law in ("tresca", "coulomb")}
+    rows = [row for law_rows, _ in runs.values() for row in law_rows]
     df = pd.DataFrame(rows)
     fig = _plot_solver_comparison(df)
     tight = df[df["tol"] == min(prm.compare_tols)]
@@ -309,6 +206,7 @@ def figure_solver_comparison(prm: Params, pr) -> ArtefactResult:
                     ", ".join(f"{r.friction}/{r.method}: {r.iterations}"
                               for r in tight.itertuples()), kind="beyond")]
     return ArtefactResult("figure_solver_comparison", df, figure=fig, claims=claims,
-                          notes=" ".join(CHOICES) + " rel_difference = 0: the run returned "
+                          notes=" ".join(mr.CHOICES) + " rel_difference = 0: the run returned "
                           "the reference solution bit for bit.",
-                          meta=dict(run_s=time.perf_counter() - t0))
+                          meta=dict(run_s=time.perf_counter() - t0),
+                          exports=mortar.mortar_exports(pr, runs["coulomb"][1]))

@@ -31,28 +31,36 @@ Table 4.2: DtN iterations (Uzawa iterations of the first DtN iteration) on the d
 grid, non-convergence detected; Figure 4.21: the fields at omega_D = 0.5, omega_N = 0.7
 with the plastic region, and the relative differences between the mortar and the
 penalty solutions on common points.  The choices where the thesis is silent are
-:data:`.scene.CHOICES` (penalty) and :data:`.scene.MORTAR_CHOICES`.
+:data:`hpfebe.scenes.section44_runs.CHOICES` (penalty) and
+:data:`~hpfebe.scenes.section44_runs.MORTAR_CHOICES`.
 
 Jobs (:data:`SCENES`): "penalty" (Table 4.3, :mod:`.penalty`), "dtn" (Table 4.2 and
 the monolithic Newton, :mod:`.dtn`), "fields" (both figures, :mod:`.fields`: they share
 the penalty runs and Figure 4.22's ranges; the comparison of the two methods
 :mod:`.comparison`, the drawings :mod:`.plots`).  The scene, its parameters and the
-published numbers: :mod:`.scene`.  The explanations of the figures' and Table 4.2's
-differences are re-tested on :func:`.scene.sensitivity_variants` (interface mesh
-alignment, load steps, refinement) and kept as explanations only where they survive
-them; readings that are not derived are hypotheses.
+published colour bars: :mod:`hpfebe.scenes.section44`; the runs:
+:mod:`hpfebe.scenes.section44_runs`; the fields compared and exported:
+:mod:`hpfebe.scenes.section44_fields`; what the claims rest on:
+:mod:`hpfebe.scenes.section44_readings` (Tables 4.2, 4.3) and
+:mod:`hpfebe.scenes.section44_figures` (the colour bars).  The explanations of the
+figures' and Table 4.2's differences are re-tested on
+:func:`hpfebe.scenes.section44.sensitivity_variants` (interface mesh alignment, load
+steps, refinement) and kept as explanations only where they survive them; readings that
+are not derived are hypotheses.  ParaView files (``exports``): the final state of each
+job - the stiffest penalty run (table_4_3), the DtN solution at Figure 4.21's dampings
+(table_4_2), both figures' solutions.
 """
 
 from __future__ import annotations
 
 import functools
 
+from hpfebe.scenes import section44, section44_runs
 from hpfebe.suite import ArtefactResult, from_config, select_scenes, timed
 
 from .dtn import mortar_sweep, table_4_2
 from .fields import figures
 from .penalty import table_4_3
-from .scene import Params, mortar_scene, run_penalty
 
 ARTEFACTS = ("table_4_3", "figure_4_22", "table_4_2", "figure_4_21")
 #: independent computations: Table 4.3's penalty sweeps (both contact treatments, the
@@ -66,14 +74,14 @@ SCENES = {"penalty": ("table_4_3",), "dtn": ("table_4_2",),
 def run(config: dict, quick: bool = False, scenes=None) -> list[ArtefactResult]:
     """The artefacts of the scenes asked for (:data:`SCENES`; None: all); ``quick`` is
     unused: config/quick.yaml sets the sizes."""
-    prm = from_config(Params, config, scene="ch4_section44")
+    prm = from_config(section44.Section44Scene, config, scene="ch4_section44")
     scenes = select_scenes(SCENES, scenes, "ch4_section44")
     solve = penalty_solver()            # scenes run together share their penalty runs
     out = {}
     if "penalty" in scenes:
         out["table_4_3"] = table_4_3(prm, solve)
     if "dtn" in scenes:
-        pr, setup = timed(mortar_scene, prm)
+        pr, setup = timed(section44_runs.mortar_scene, prm)
         tab, sols = mortar_sweep(prm, pr)
         out["table_4_2"] = table_4_2(prm, pr, tab, sols, setup)
     if "fields" in scenes:
@@ -82,6 +90,7 @@ def run(config: dict, quick: bool = False, scenes=None) -> list[ArtefactResult]:
 
 
 def penalty_solver():
-    """:func:`run_penalty` memoised on (parameters, factor): Table 4.3, both figures,
-    the comparison variants and the sensitivity checks ask for the same runs."""
-    return functools.lru_cache(maxsize=None)(run_penalty)
+    """:func:`hpfebe.scenes.section44_runs.run_penalty` memoised on (parameters, factor):
+    Table 4.3, both figures, the comparison variants and the sensitivity checks ask for
+    the same runs."""
+    return functools.lru_cache(maxsize=None)(section44_runs.run_penalty)

@@ -1,6 +1,7 @@
 """The drawings of Figures 4.21 and 4.22: u_x, u_y of the work piece (row 1) and of the
 stamp (row 2), the work piece's ||dev sigma|| (with the plastic region of the mortar
-solution outlined), and the colour bar ranges (ours | the thesis's) beside them."""
+solution outlined), and the colour bar ranges (ours | the thesis's) beside them
+(:func:`hpfebe.scenes.section44_fields.colour_ranges`)."""
 
 from __future__ import annotations
 
@@ -10,35 +11,6 @@ from matplotlib.collections import PolyCollection
 from matplotlib.figure import Figure
 
 from hpfebe.suite import new_figure
-
-from .scene import (PUB_DEV_MAX, PUB_MORTAR_DEV_MAX, PUB_MORTAR_UX, PUB_MORTAR_UY, PUB_UX,
-                    PUB_UY, Run)
-
-
-def _ranges(bodies: dict, dev: np.ndarray, pub_ux: dict, pub_uy: dict,
-            pub_dev_max: float) -> pd.DataFrame:
-    """Our colorbar ranges (nodal u_x, u_y of both bodies, ||dev sigma_m||) beside the
-    published ones of Figure 4.21 or 4.22."""
-    rows = []
-    for b, (_, _, u) in bodies.items():
-        for c, name, pub in ((0, "u_x", pub_ux), (1, "u_y", pub_uy)):
-            rows.append(dict(body=b, field=name, ours_min=float(u[:, c].min()),
-                             ours_max=float(u[:, c].max()), published_min=pub[b][0],
-                             published_max=pub[b][1]))
-    rows.append(dict(body="work", field="dev_sigma_norm", ours_min=float(dev.min()),
-                     ours_max=float(dev.max()), published_min=float("nan"),
-                     published_max=pub_dev_max))
-    return pd.DataFrame(rows)
-
-
-def colour_ranges(bodies: dict, r: Run) -> pd.DataFrame:
-    return _ranges(bodies, r.peak.fields["dev_sigma_norm"], PUB_UX, PUB_UY, PUB_DEV_MAX)
-
-
-def mortar_ranges(bodies: dict, sol) -> pd.DataFrame:
-    return _ranges(bodies, sol.extra["fields"]["dev_sigma_norm_mean"], PUB_MORTAR_UX,
-                   PUB_MORTAR_UY, PUB_MORTAR_DEV_MAX)
-
 
 LIMITS = {"work": ((-2.1, 2.1), (-2.1, 0.1)), "stamp": ((-0.6, 0.6), (-0.1, 2.1))}
 

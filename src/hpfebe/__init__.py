@@ -25,7 +25,13 @@ first use (PEP 562): importing all of them costs about 0.2 s more than ``import 
 
 from importlib import import_module
 
+from . import _numba_cache
+
 __version__ = "0.1.0"
+
+# before any kernel is defined: numba's cache keyed on every kernel source (a cached
+# kernel keeps the machine code of the jitted functions of other files it calls)
+_numba_cache.configure()
 
 #: public name -> the module that defines it
 _API = {

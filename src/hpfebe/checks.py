@@ -6,6 +6,8 @@ Every check names the parameter, shows the value it got and says what is allowed
     real("sigma_Y", np.float32(4), positive=True)      -> 4.0
     real("nu", 0.5, lo=-1, hi=0.5, lo_open=True, hi_open=True)
         ValueError: nu must be a finite real number in (-1, 0.5), got 0.5
+    tolerance("tol", 2.0)
+        ValueError: tol must be a finite real number in (0, 1), got 2.0
     integer("max_cuts", 1.5, lo=0)
         ValueError: max_cuts must be an integer >= 0, got 1.5
     boolean("predictor", "no")
@@ -28,7 +30,7 @@ from collections.abc import Callable, Iterable
 
 import numpy as np
 
-__all__ = ["InputTypeError", "real", "integer", "boolean", "choice", "array",
+__all__ = ["InputTypeError", "real", "tolerance", "integer", "boolean", "choice", "array",
            "instance", "callable_returning", "finite"]
 
 
@@ -102,6 +104,14 @@ def real(name: str, value, *, positive: bool = False, nonnegative: bool = False,
     if bad:
         raise ValueError(f"{name} must be {what}, got {_got(value)}")
     return v
+
+
+def tolerance(name: str, value) -> float:
+    """A relative tolerance of a stopping test: a real number in (0, 1).  0 never stops
+    (or, beside an absolute floor, is not scale-free); 1 or more accepts a residual or
+    increment as large as the quantity it is measured against ("converged" would mean
+    nothing)."""
+    return real(name, value, lo=0.0, hi=1.0, lo_open=True, hi_open=True)
 
 
 def integer(name: str, value, *, lo=None, hi=None, allow_none: bool = False):

@@ -116,13 +116,13 @@ def remove_stale_temporaries(out: Path, artefacts) -> list[Path]:
 
 # --------------------------------------------------------------------------- locating
 def find_root() -> Path:
-    """The repository root: the directory holding ``experiments/registry.py``.
+    """The repository root: the directory holding ``experiments/__init__.py``.
 
     Looked up in order: the parent of ``src/`` of this (editable) package, then the
     current working directory."""
     candidates = [Path(__file__).resolve().parents[2], Path.cwd()]
     for c in candidates:
-        if (c / "experiments" / "registry.py").is_file():
+        if (c / "experiments" / "__init__.py").is_file():
             return c
     raise CLIError(
         "cannot find the experiments/ package. Looked in: "
@@ -140,13 +140,15 @@ def _import_experiments(root: Path):
     if where != (root / "experiments").resolve():
         raise CLIError(f"'import experiments' found {where}, not {root / 'experiments'}: "
                        "another package named 'experiments' shadows the suite's")
-    return importlib.import_module("experiments.registry")
+    return pkg
 
 
 def load_registry(root: Path):
-    reg = _import_experiments(root)
+    from .suite.registry import discover
+
+    _import_experiments(root)
     try:
-        return reg.discover(root / "experiments")
+        return discover(root / "experiments")
     except (ValueError, SyntaxError) as exc:
         raise CLIError(f"experiment registry: {exc}") from exc
 
@@ -217,7 +219,7 @@ def check_top_level(per_file: list[tuple[Path, dict]], config: dict, modules) ->
     """The merged config's top level: ``quick`` a real bool (``"false"`` is not false),
     every section a mapping, a section name close to a module name but not one of them
     (a misspelling) an error; returns ``quick``."""
-    from experiments.registry import unknown_sections
+    from .suite.registry import unknown_sections
 
     quick = config.get("quick", False)
     if not isinstance(quick, bool):
@@ -447,6 +449,7 @@ def cmd_report(args) -> int:
 def cmd_compile(args) -> int:
     """Compile (or load from numba's cache) every numba kernel once; with --stamp FILE,
     record the times in FILE (JSON, written atomically: the workflow's numba_cache rule)."""
+    from . import _numba_cache
     from .suite.results import atomic_write
     from .suite.warmup import compile_kernels
 
@@ -454,8 +457,13 @@ def cmd_compile(args) -> int:
         t0 = time.perf_counter()
         steps = compile_kernels()
         wall = time.perf_counter() - t0
-    log.info("numba kernels ready in %.1f s (compiling %.1f s): %s", wall, jit.compile_s,
-             ", ".join(f"{k} {v:.2f} s" for k, v in steps.items()))
+    cache = Path(os.environ[_numba_cache.ENV])
+    log.info("numba kernels ready in %.1f s (compiling %.1f s; cache %s): %s", wall,
+             jit.compile_s, cache, ", ".join(f"{k} {v:.2f} s" for k, v in steps.items()))
+    if cache.is_dir():
+        os.utime(cache)                  # readied now: kept by remove_stale
+    for old in _numba_cache.remove_stale():
+        log.info("removed the numba cache of an older source tree: %s", old)
     if args.stamp:
         record = dict(wall_s=round(wall, 3), steps_s={k: round(v, 3) for k, v in steps.items()},
                       **jit.as_dict())

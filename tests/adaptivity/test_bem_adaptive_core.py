@@ -12,7 +12,7 @@ from hpfebe.adaptivity import adapt, lame_bem_indicators
 from hpfebe.adaptivity.bem_estimator import (consistency_weight, contact_traction,
                                              lame_contact_indicators, norm_B, true_error)
 from hpfebe.bem.lame import LameBEM
-from hpfebe.contact.friction import solve_friction
+from hpfebe.contact.friction import FrictionSettings, solve_friction
 from hpfebe.geometry import common_refinement
 from hpfebe.spaces import prolongate
 
@@ -32,7 +32,7 @@ def line_gap(d):
 
 def solve(mesh, d=6e-4, eps=EPS):
     op = LameBEM(mesh, E, NU, "strain")
-    res = solve_friction(op, eps, eps, line_gap(d), friction="coulomb", mu_f=MU_F)
+    res = solve_friction(op, line_gap(d), FrictionSettings(eps, eps, "coulomb", mu_f=MU_F))
     assert res.converged, res.reason
     return op, res, op.Psi(res.U)
 

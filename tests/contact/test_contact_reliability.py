@@ -11,7 +11,7 @@ import pytest
 from hpfebe import BoundaryMesh
 from hpfebe.bem import LaplaceBEM
 from hpfebe.bem.lame import LameBEM
-from hpfebe.contact import solve_friction, solve_penalty
+from hpfebe.contact import FrictionSettings, solve_friction, solve_penalty
 
 E, NU, D = 266926.0, 0.29, 2e-4
 
@@ -33,8 +33,8 @@ def test_nan_load_named_as_such(body):
     load = np.zeros(2 * body.V_space.ndof)
     load[3] = np.nan
     for solve in (lambda: solve_penalty(body, 1e-5, -D, load=load),
-                  lambda: solve_friction(body, 1e-5, 1e-5, -D, friction="coulomb",
-                                         mu_f=0.3, load=load)):
+                  lambda: solve_friction(body, -D, FrictionSettings(
+                                      1e-5, 1e-5, "coulomb", mu_f=0.3), load=load)):
         with pytest.raises(ValueError, match="load must be finite"):
             solve()
 
@@ -44,7 +44,7 @@ def test_laplace_operator_refused(body):
     with pytest.raises(ValueError, match="LameBEM"):
         solve_penalty(lap, 1e-5, -D)
     with pytest.raises(ValueError, match="LameBEM"):
-        solve_friction(lap, 1e-5, 1e-5, -D, friction="tresca", F=1.0)
+        solve_friction(lap, -D, FrictionSettings(1e-5, 1e-5, "tresca", F=1.0))
 
 
 def test_wrong_S_shape_named(body):
@@ -56,8 +56,8 @@ def test_scalar_gap_callable_is_refused(body):
     """Issue 25: a gap callable must return one value per point (a scalar may be a
     constant or ``norm(x) - 1`` of all points at once); a constant gap is a float."""
     for solve in (lambda: solve_penalty(body, 1e-5, lambda x: -D),
-                  lambda: solve_friction(body, 1e-5, 1e-5, lambda x: -D,
-                                         friction="coulomb", mu_f=0.3)):
+                  lambda: solve_friction(body, lambda x: -D, FrictionSettings(
+                                      1e-5, 1e-5, "coulomb", mu_f=0.3))):
         with pytest.raises(ValueError, match=r"gap\(x\) must have shape \(\d+,\)"):
             solve()
 
@@ -80,6 +80,6 @@ def test_friction_at_extreme_eps_names_ill_conditioning(body):
     Newton matrix (body not fixed?)": the body is fixed; the cause is conditioning."""
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        res = solve_friction(body, 1e-20, 1e-20, -D, friction="coulomb", mu_f=0.3)
+        res = solve_friction(body, -D, FrictionSettings(1e-20, 1e-20, "coulomb", mu_f=0.3))
     assert not res.converged
     assert "ill-conditioned" in res.reason and "not fixed" not in res.reason, res.reason

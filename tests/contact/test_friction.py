@@ -14,12 +14,19 @@ import pytest
 
 from hpfebe import BoundaryMesh
 from hpfebe.bem.lame import LameBEM
-from hpfebe.contact import solve_penalty
 from hpfebe.bodies import BEBody, RigidObstacle
-from hpfebe.contact import TwoBodyContact
-from hpfebe.contact.friction import SLIP, STICK, solve_friction
+from hpfebe.constitutive import SLIP, STICK
+from hpfebe.contact import FrictionSettings, TwoBodyContact, solve_friction, solve_penalty
 from hpfebe.quadrature import gauss_legendre
 from hpfebe.spaces import lagrange_values
+
+
+def _solve(bem, eps_n, eps_t, gap, obstacle_slip=None, load=None, S=None, initial=None,
+           **law):
+    """:func:`solve_friction` with the law and solver keywords ``law`` of
+    :class:`FrictionSettings`."""
+    return solve_friction(bem, gap, FrictionSettings(eps_n, eps_t, **law),
+                          obstacle_slip=obstacle_slip, load=load, S=S, initial=initial)
 
 E, NU, D = 266926.0, 0.29, 2e-4
 EPS_N = EPS_T = 1e-5
@@ -66,7 +73,7 @@ def _check_equation(bem, res, law, w, bound=None):
 
 def test_coulomb_stick_below_threshold(body):
     w = 5e-5
-    res = solve_friction(body, EPS_N, EPS_T, -D, friction="coulomb", mu_f=MU,
+    res = _solve(body, EPS_N, EPS_T, -D, friction="coulomb", mu_f=MU,
                          obstacle_slip=w)
     assert res.converged and res.reason == "converged", res.reason
     assert np.all(res.state == STICK)
@@ -101,7 +108,7 @@ def test_coulomb_stick_below_threshold(body):
 
 def test_coulomb_full_slip_above_threshold(body):
     w = 1e-3
-    res = solve_friction(body, EPS_N, EPS_T, -D, friction="coulomb", mu_f=MU,
+    res = _solve(body, EPS_N, EPS_T, -D, friction="coulomb", mu_f=MU,
                          obstacle_slip=w, predictor=False)
     assert res.converged, res.reason
     assert np.all(res.state == SLIP) and np.all(res.p_n > 0)
@@ -116,7 +123,7 @@ def test_coulomb_full_slip_above_threshold(body):
     # (including d p_n / dU in the slip term) Newton needs exactly one step from U = 0
     assert res.iterations == [1] and not res.steps[0].predictor_used
     # monotone loading in 4 increments: the same end state (path independent in full slip)
-    res4 = solve_friction(body, EPS_N, EPS_T, -D, friction="coulomb", mu_f=MU,
+    res4 = _solve(body, EPS_N, EPS_T, -D, friction="coulomb", mu_f=MU,
                           obstacle_slip=w, load_steps=4)
     assert res4.converged and len(res4.steps) == 4
     assert [s.load_factor for s in res4.steps] == [0.25, 0.5, 0.75, 1.0]
@@ -124,13 +131,13 @@ def test_coulomb_full_slip_above_threshold(body):
 
 
 def test_tresca_stick_partial_and_full_slip(body):
-    stick = solve_friction(body, EPS_N, EPS_T, -D, friction="tresca", F=FT,
+    stick = _solve(body, EPS_N, EPS_T, -D, friction="tresca", F=FT,
                            obstacle_slip=1e-5)
     assert stick.converged and np.all(stick.state == STICK)
     assert np.abs(stick.t_t).max() < 0.5 * FT
     _check_equation(body, stick, "tresca", 1e-5, FT)
 
-    part = solve_friction(body, EPS_N, EPS_T, -D, friction="tresca", F=FT,
+    part = _solve(body, EPS_N, EPS_T, -D, friction="tresca", F=FT,
                           obstacle_slip=1e-3)
     assert part.converged, part.reason
     sl = part.state == SLIP
@@ -144,7 +151,7 @@ def test_tresca_stick_partial_and_full_slip(body):
     assert np.abs(part.slip[~sl]).max() <= 1e-12 * np.abs(part.slip).max()
     assert np.all(part.slip[sl] < 0)
 
-    full = solve_friction(body, EPS_N, EPS_T, -D, friction="tresca", F=FT,
+    full = _solve(body, EPS_N, EPS_T, -D, friction="tresca", F=FT,
                           obstacle_slip=1e-2)
     assert full.converged and np.all(full.state == SLIP)
     assert np.allclose(full.t_t, -FT, rtol=1e-12, atol=0)
@@ -159,7 +166,7 @@ def test_newton_converges_quadratically(body):
     last two steps (C = 50; measured <= 25), a final drop below 1e-12, few iterations."""
     for law, kw, w in (("tresca", {"F": FT}, 1e-3), ("coulomb", {"mu_f": MU}, 1e-4),
                        ("tresca", {"F": 10.0}, 3e-4), ("coulomb", {"mu_f": MU}, 1.8e-4)):
-        res = solve_friction(body, EPS_N, EPS_T, -D, friction=law, obstacle_slip=w,
+        res = _solve(body, EPS_N, EPS_T, -D, friction=law, obstacle_slip=w,
                              predictor=False, **kw)
         assert res.converged, (law, res.reason)
         r = np.array(res.residuals[0]) / res.residuals[0][0]
@@ -174,7 +181,7 @@ def test_linearisation_is_consistent(body):
     gap = lambda p: -D + 3e-4 * (p[:, 0] + 1)            # tilted obstacle: open points
     motion = lambda p: 2e-4 * (1 + p[:, 0])
     rng = np.random.default_rng(0)
-    res = solve_friction(body, EPS_N, EPS_T, gap, friction="coulomb", mu_f=MU,
+    res = _solve(body, EPS_N, EPS_T, gap, friction="coulomb", mu_f=MU,
                          obstacle_slip=motion)
     assert res.converged, res.reason
     U = res.U
@@ -201,7 +208,7 @@ def test_frictionless_limit_matches_penalty(body):
     penalty.py (full contact: no kink inside elements, both integrations exact)."""
     ref = solve_penalty(body, EPS_N, -D)
     for kw in ({"friction": "tresca", "F": 0.0}, {"friction": "coulomb", "mu_f": 0.0}):
-        res = solve_friction(body, EPS_N, EPS_T, -D, obstacle_slip=1e-4, **kw)
+        res = _solve(body, EPS_N, EPS_T, -D, obstacle_slip=1e-4, **kw)
         assert res.converged
         assert np.abs(res.U - ref.U).max() <= 1e-10 * np.abs(ref.U).max()
         assert np.all(res.t_t == 0)
@@ -224,23 +231,23 @@ def test_bad_input(body, kw, name):
     args = dict(eps_n=EPS_N, eps_t=EPS_T, gap=-D, friction="tresca", F=FT)
     args.update(kw)
     with pytest.raises(ValueError, match=name):
-        solve_friction(body, **args)
+        _solve(body, **args)
 
 
 def test_non_convergence_is_reported(body):
-    res = solve_friction(body, EPS_N, EPS_T, -D, friction="tresca", F=FT,
+    res = _solve(body, EPS_N, EPS_T, -D, friction="tresca", F=FT,
                          obstacle_slip=1e-3, max_iter=2, predictor=False)
     assert not res.converged
     assert res.reason == "load step 1/1: max_iter"
     assert res.steps[0].iterations == 2 and len(res.residuals[0]) == 3
     # a multi-step run stops at the failing step and says which
-    res = solve_friction(body, EPS_N, EPS_T, -D, friction="tresca", F=FT,
+    res = _solve(body, EPS_N, EPS_T, -D, friction="tresca", F=FT,
                          obstacle_slip=4e-3, load_steps=4, max_iter=1, predictor=False)
     assert not res.converged and res.reason.startswith("load step ")
     assert len(res.steps) < 4 or not res.steps[-1].converged
     # a singular Newton matrix (no elastic stiffness, no contact) is detected
     zero = np.zeros_like(body.S_hat)
-    res = solve_friction(body, EPS_N, EPS_T, +1e-3, friction="tresca", F=FT,
+    res = _solve(body, EPS_N, EPS_T, +1e-3, friction="tresca", F=FT,
                          obstacle_slip=1e-6, S=zero)
     assert not res.converged and "singular" in res.reason
 
@@ -278,7 +285,7 @@ def _top_load(bem, qx, qy):
 @pytest.mark.parametrize("law, kw", [("coulomb", {"mu_f": MU}), ("tresca", {"F": 3.0})])
 def test_neumann_load_equilibrium_stick_and_partial_slip(free_body, law, kw):
     for qx, steps in ((0.5, 1), (2.9, 1), (2.9, 3)):
-        res = solve_friction(free_body, EPS_N, EPS_T, -D, friction=law,
+        res = _solve(free_body, EPS_N, EPS_T, -D, friction=law,
                              load=_top_load(free_body, qx, -QY), load_steps=steps, **kw)
         assert res.converged, (law, qx, res.reason)
         Fn, Ft = res.total_forces()
@@ -298,7 +305,7 @@ def test_neumann_load_equilibrium_stick_and_partial_slip(free_body, law, kw):
 def test_shear_beyond_friction_capacity_is_reported(free_body, law, kw):
     """2 q_x = 7 > capacity 6: no equilibrium exists; Newton must not claim convergence
     (the full-slip Newton matrix has the tangential translation in its kernel)."""
-    res = solve_friction(free_body, EPS_N, EPS_T, -D, friction=law,
+    res = _solve(free_body, EPS_N, EPS_T, -D, friction=law,
                          load=_top_load(free_body, 3.5, -QY), **kw)
     assert not res.converged
     assert res.reason.startswith("load step 1/1: ")
@@ -311,22 +318,22 @@ def test_history_unloading_is_elastic_then_reverse_slip(body):
     every point sticks, the accumulated slip g_t^p is unchanged and |t_t| < F.  Returning
     all the way to w = 0 makes the whole contact slip backwards (t_t = +F) - unlike the
     virgin solution at w = 0, which sticks: the slip history is carried."""
-    a = solve_friction(body, EPS_N, EPS_T, -D, friction="tresca", F=FT, obstacle_slip=1e-2)
+    a = _solve(body, EPS_N, EPS_T, -D, friction="tresca", F=FT, obstacle_slip=1e-2)
     assert a.converged and np.all(a.state == SLIP)
-    b = solve_friction(body, EPS_N, EPS_T, -D, friction="tresca", F=FT,
+    b = _solve(body, EPS_N, EPS_T, -D, friction="tresca", F=FT,
                        obstacle_slip=1e-2 - 1e-6, initial=a)
     assert b.converged, b.reason
     assert np.all(b.state == STICK)
     assert np.all((b.t_t > -FT) & (b.t_t < -FT + 0.5 * FT))
     assert np.abs(b.slip - a.slip).max() <= 1e-12 * np.abs(a.slip).max()
-    c = solve_friction(body, EPS_N, EPS_T, -D, friction="tresca", F=FT,
+    c = _solve(body, EPS_N, EPS_T, -D, friction="tresca", F=FT,
                        obstacle_slip=0.0, initial=b, load_steps=2)
     assert c.converged and np.all(c.state == SLIP)
     assert np.allclose(c.t_t, FT, rtol=1e-12, atol=0)
-    virgin = solve_friction(body, EPS_N, EPS_T, -D, friction="tresca", F=FT)
+    virgin = _solve(body, EPS_N, EPS_T, -D, friction="tresca", F=FT)
     assert np.all(virgin.state == STICK) and np.abs(virgin.t_t).max() < 0.2 * FT
     with pytest.raises(ValueError, match="initial"):
-        solve_friction(body, EPS_N, EPS_T, -D, friction="coulomb", mu_f=MU, initial=a)
+        _solve(body, EPS_N, EPS_T, -D, friction="coulomb", mu_f=MU, initial=a)
 
 
 @pytest.mark.parametrize("law, kw, w", [("tresca", {"F": FT}, 5e-5),
@@ -338,9 +345,9 @@ def test_stiff_penalty_bonded_predictor(body, law, kw, w):
     eps_t s), with the bonded predictor <= 4; both reach the same solution, and it solves
     the equation (independent residual, to the conditioning ~ 1/eps)."""
     eps = 1e-7 / 6
-    plain = solve_friction(body, eps, eps, -D, friction=law, obstacle_slip=w,
+    plain = _solve(body, eps, eps, -D, friction=law, obstacle_slip=w,
                            predictor=False, **kw)
-    pred = solve_friction(body, eps, eps, -D, friction=law, obstacle_slip=w, **kw)
+    pred = _solve(body, eps, eps, -D, friction=law, obstacle_slip=w, **kw)
     assert plain.converged and pred.converged, (plain.reason, pred.reason)
     assert plain.iterations[0] > 15
     assert pred.iterations[0] <= 4 and pred.steps[0].predictor_used
@@ -349,3 +356,15 @@ def test_stiff_penalty_bonded_predictor(body, law, kw, w):
     assert (pred.state == STICK).sum() >= 12                  # mostly sticking
     r = _independent_residual(body, pred.U, law, w, kw.get("F"), eps, eps)
     assert np.abs(r).max() <= 1e-7 * np.abs(body.S_hat @ pred.U).max()
+
+
+def test_settings_are_a_frozen_validated_object(body):
+    """solve_friction takes a FrictionSettings (not loose keywords); the settings are
+    validated when created and cannot be changed afterwards."""
+    st = FrictionSettings(EPS_N, EPS_T, "Coulomb", mu_f=MU)
+    assert st.friction == "coulomb" and st.bound == {"mu_f": MU}
+    with pytest.raises(AttributeError):
+        st.max_iter = 3
+    with pytest.raises(TypeError, match="settings"):
+        solve_friction(body, -D, dict(eps_n=EPS_N, eps_t=EPS_T, friction="coulomb",
+                                      mu_f=MU))

@@ -4,20 +4,20 @@ model problem of Section 4.3.4 (coarse meshes to stay fast)."""
 import numpy as np
 import pytest
 
-from hpfebe.scenes import model_problem
+from hpfebe.scenes import ModelProblem, model_problem
 from hpfebe.solvers import (DtNSettings, GlobalUzawaSettings, SemismoothSettings,
                             UzawaSettings)
 
 
 @pytest.fixture(scope="module")
 def coarse():
-    return model_problem(n1=8, n2=6, p1=2, p2=1)
+    return model_problem(ModelProblem(n1=8, n2=6, p1=2, p2=1))
 
 
 @pytest.fixture(scope="module")
 def sticky():
     # friction bound comparable to the contact pressure: stick and slip zones
-    return model_problem(n1=8, n2=6, p1=2, p2=2, F=4000.0)
+    return model_problem(ModelProblem(n1=8, n2=6, p1=2, p2=2, F=4000.0))
 
 
 def test_uzawa_fixed_point_satisfies_tresca(sticky):
@@ -70,7 +70,7 @@ def test_bad_input(coarse):
     with pytest.raises(ValueError, match="rho"):
         coarse.uzawa(np.zeros(2 * coarse.nc), UzawaSettings(rho=-1.0))
     with pytest.raises(ValueError, match="F"):
-        model_problem(n1=4, n2=3, p1=1, p2=1, F=-1.0)
+        model_problem(ModelProblem(n1=4, n2=3, p1=1, p2=1, F=-1.0))
     with pytest.raises(ValueError, match="friction"):
         coarse.dtn(DtNSettings(0.5, 0.5), friction="stick")
 
@@ -233,10 +233,10 @@ def test_model_problem_bem_cache():
     """A shared bem_cache reuses body 2 across body-1 degrees, with the same numbers as
     a fresh set-up."""
     cache = {}
-    a = model_problem(n1=4, n2=3, p1=1, p2=1, bem_cache=cache)
-    b = model_problem(n1=4, n2=3, p1=2, p2=1, bem_cache=cache)
+    a = model_problem(ModelProblem(n1=4, n2=3, p1=1, p2=1), bem_cache=cache)
+    b = model_problem(ModelProblem(n1=4, n2=3, p1=2, p2=1), bem_cache=cache)
     assert b.bem2 is a.bem2 and b.bem1 is not a.bem1 and len(cache) == 3
-    fresh = model_problem(n1=4, n2=3, p1=2, p2=1)
+    fresh = model_problem(ModelProblem(n1=4, n2=3, p1=2, p2=1))
     assert np.array_equal(b.A, fresh.A) and np.array_equal(b.body2.A, fresh.body2.A)
 
 

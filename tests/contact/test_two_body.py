@@ -47,11 +47,27 @@ def uniaxial_strains(plane):
     return Q * NU / E, -Q / E
 
 
-def patch_solve(pr):
+def supports(pr, slave_x=True):
+    """The supports of the two-block scenes: the master's bottom in y, its corner
+    (0, -1) in x and, with ``slave_x``, the slave's corner (0, 1) in x (the rigid
+    sliding of a slave without friction or tangential load)."""
+    dofs = [pr.dofs_on("master", "bottom", 1), pr.dofs_at("master", (0, -1), 0)]
+    if slave_x:
+        dofs.append(pr.dofs_at("slave", (0, 1), 0))
+    return np.concatenate(dofs)
+
+
+def patch_solve(pr, check=True):
+    """The patch test: pressure Q on the slave's top, two load steps; ``check``: the
+    contact is closed everywhere and carries Q exactly (pointwise and in total)."""
     f = pr.traction_load("slave", "top", (0.0, -Q))
-    fixed = np.concatenate([pr.dofs_on("master", "bottom", 1), pr.dofs_at("master", (0, -1), 0),
-                            pr.dofs_at("slave", (0, 1), 0)])
-    return pr.solve(f, fixed, None, load_factors=[0.5, 1.0])
+    res = pr.solve(f, supports(pr), None, load_factors=[0.5, 1.0])
+    if check:
+        assert res.converged, res.reason
+        assert np.all(res.state != OPEN)
+        assert np.max(np.abs(res.p_n / Q - 1)) < TOL              # uniform pressure Q
+        assert abs(np.sum(res.weights * res.p_n) / (2 * Q) - 1) < TOL   # total force
+    return res
 
 
 # ---------------------------------------------------------------- patch test
@@ -59,12 +75,6 @@ def patch_solve(pr):
 def test_contact_patch_test(kind, plane):
     pr = blocks(kind, plane)
     res = patch_solve(pr)
-    assert res.converged, res.reason
-    assert np.all(res.state != OPEN)
-    # uniform pressure = applied pressure
-    assert np.max(np.abs(res.p_n / Q - 1)) < TOL
-    # total contact force = applied force
-    assert abs(np.sum(res.weights * res.p_n) / (2 * Q) - 1) < TOL
     # exact uniaxial displacements, slave shifted by the penalty penetration eps_n * Q
     exx, eyy = uniaxial_strains(plane)
     for body, shift in (("master", eyy), ("slave", eyy - EPS * Q)):
@@ -81,7 +91,7 @@ def test_contact_patch_test(kind, plane):
 def test_patch_test_needs_segment_split():
     """Plain Gauss-point-to-segment integration (no split at master vertices) fails the
     patch test at the percent level: the split is what makes it exact."""
-    res = patch_solve(blocks(split=False))
+    res = patch_solve(blocks(split=False), check=False)
     assert res.converged
     assert np.max(np.abs(res.p_n / Q - 1)) > 1e-2
 
@@ -94,9 +104,7 @@ def test_partial_lift_off_equilibrium():
     support carries no moment-producing reaction since all forces are vertical)."""
     pr = blocks("quad", nx=(8, 10))
     f = pr.traction_load("slave", "top", lambda x, y: (0 * x, -Q * (x < 0.5)))
-    fixed = np.concatenate([pr.dofs_on("master", "bottom", 1), pr.dofs_at("master", (0, -1), 0),
-                            pr.dofs_at("slave", (0, 1), 0)])
-    res = pr.solve(f, fixed, None, load_factors=[0.5, 1.0])
+    res = pr.solve(f, supports(pr), None, load_factors=[0.5, 1.0])
     assert res.converged, res.reason
     open_, act = res.state == OPEN, res.state == SLIP      # frictionless: active = slip
     assert open_.sum() >= 5 and act.sum() >= 5 and np.all(open_ | act)
@@ -120,14 +128,12 @@ def shear_loads(pr, tau, top_traction):
     return f
 
 
-@pytest.mark.parametrize("kind", ["quad", "tri"])
-def test_stick_below_coulomb_bound(kind):
+def check_stick(pr, load_factors):
     """tau = 0.5 mu Q applied on the slave's top: every point sticks and transmits the
-    traction exactly, t_t = tau < mu p_n; relative slip = eps_t tau."""
-    pr = blocks(kind, mu_f=MU)
+    traction exactly, t_t = tau < mu p_n; relative slip = eps_t tau, no slip committed."""
     tau = 0.5 * MU * Q
-    fixed = np.concatenate([pr.dofs_on("master", "bottom", 1), pr.dofs_at("master", (0, -1), 0)])
-    res = pr.solve(shear_loads(pr, tau, (tau, -Q)), fixed, None, load_factors=[0.25, 0.5, 0.75, 1.0])
+    res = pr.solve(shear_loads(pr, tau, (tau, -Q)), supports(pr, slave_x=False), None,
+                   load_factors=load_factors)
     assert res.converged, res.reason
     assert np.all(res.state == STICK)
     assert np.max(np.abs(res.p_n / Q - 1)) < TOL
@@ -137,27 +143,35 @@ def test_stick_below_coulomb_bound(kind):
     assert np.max(np.abs(res.slip)) < 1e-9 * EPS * tau
 
 
-@pytest.mark.parametrize("kind", ["quad", "tri"])
-def test_slip_at_coulomb_bound(kind):
+def check_slip(pr, load_factors):
     """The slave's top is dragged by c (u_x = eps_xx x + c) under pressure Q: every point
     slips with t_t = mu_f p_n = mu Q exactly; the accumulated slip is the relative
     tangential displacement minus the elastic part eps_t t_t."""
-    pr = blocks(kind, mu_f=MU)
     tau, c = MU * Q, 2e-3
     exx, _ = uniaxial_strains("strain")
     top = pr.dofs_on("slave", "top", 0)
-    base = np.concatenate([pr.dofs_on("master", "bottom", 1), pr.dofs_at("master", (0, -1), 0)])
+    base = supports(pr, slave_x=False)
     fixed = np.concatenate([base, top])
     vals = np.concatenate([np.zeros(base.size), exx * pr.dof_coordinates()[top, 0] + c])
-    res = pr.solve(shear_loads(pr, tau, (0.0, -Q)), fixed, vals, load_factors=[0.25, 0.5, 0.75, 1.0])
+    res = pr.solve(shear_loads(pr, tau, (0.0, -Q)), fixed, vals, load_factors=load_factors)
     assert res.converged, res.reason
     assert np.all(res.state == SLIP)
     assert np.max(np.abs(res.p_n / Q - 1)) < TOL
     assert np.max(np.abs(res.t_t / (MU * res.p_n) - 1)) < TOL
     assert np.allclose(res.slip, res.g_t - EPS * res.t_t, rtol=0, atol=1e-12 * c)
     # relative slide: c minus the shear gamma = tau / G of each unit-height body
-    gamma = tau / pr.slave.mu
+    gamma = tau / (E / (2 * (1 + NU)))
     assert np.max(np.abs(res.g_t / (c - 2 * gamma) - 1)) < TOL
+
+
+@pytest.mark.parametrize("kind", ["quad", "tri"])
+def test_stick_below_coulomb_bound(kind):
+    check_stick(blocks(kind, mu_f=MU), [0.25, 0.5, 0.75, 1.0])
+
+
+@pytest.mark.parametrize("kind", ["quad", "tri"])
+def test_slip_at_coulomb_bound(kind):
+    check_slip(blocks(kind, mu_f=MU), [0.25, 0.5, 0.75, 1.0])
 
 
 # ---------------------------------------------------------------- Newton
@@ -167,13 +181,18 @@ def punch():
     clamped.  Stick everywhere at first, a stick-slip front, then full slip."""
     lower = ElasticBody(rectangle_mesh(0, 2, -1, 0, 10, 5, "tri"), E, NU)
     upper = ElasticBody(rectangle_mesh(0.5, 1.5, 0, 1, 7, 7, "quad"), E, NU)
-    pr = TwoBodyContact(upper, lower, "bottom", "top", eps_n=EPS, eps_t=EPS, mu_f=MU)
-    d, s = 1e-3, 1.5e-3
+    return press_and_drag(TwoBodyContact(upper, lower, "bottom", "top", eps_n=EPS,
+                                         eps_t=EPS, mu_f=MU))
+
+
+def press_and_drag(pr, d=1e-3, s=1.5e-3):
+    """(pr, fixed, values) of the punch scenes: the master's bottom clamped, the top of
+    the slave punch pressed down by d (0 < lam <= 1), then dragged by s (1 < lam <= 2)."""
     tx, ty = pr.dofs_on("slave", "top", 0), pr.dofs_on("slave", "top", 1)
     clamp = pr.dofs_on("master", "bottom")
     fixed = np.concatenate([clamp, tx, ty])
 
-    def values(lam):  # press (0 < lam <= 1), then shear (1 < lam <= 2)
+    def values(lam):
         return np.concatenate([np.zeros(clamp.size), np.full(tx.size, s * max(lam - 1, 0)),
                                np.full(ty.size, -d * min(lam, 1))])
 
@@ -185,22 +204,26 @@ def quadratic_last_step(residuals, C=1.0):
     return len(r) >= 3 and r[-1] <= C * r[-2] ** 2
 
 
-def test_newton_converges_quadratically_with_stick_slip():
-    pr, fixed, values = punch()
+def check_quadratic_press_and_drag(pr, fixed, values, last=1e-10):
+    """The punch pressed and dragged (8 load steps): at most 4 Newton iterations a step;
+    the shear phase goes through mixed stick/slip into full slip at the Coulomb bound;
+    every step that needs more than one iteration ends quadratically, at a residual
+    below ``last`` times its first."""
     res = pr.solve(None, fixed, values, load_factors=np.linspace(0.25, 2.0, 8))
     assert res.converged, res.reason
     assert all(st.converged for st in res.steps)
     assert max(res.iterations) <= 4
-    # the shear phase goes through mixed stick/slip into full slip
     assert any(st.counts["stick"] > 0 and st.counts["slip"] > 0 for st in res.steps)
     assert np.all(res.state == SLIP)
     assert np.max(np.abs(np.abs(res.t_t) - MU * res.p_n)) <= 1e-9 * MU * res.p_n.max()
-    # every step that needs more than one Newton iteration ends quadratically
     multi = [st.residuals for st in res.steps if st.iterations >= 2]
-    assert multi
-    assert all(quadratic_last_step(r) for r in multi)
+    assert multi and all(quadratic_last_step(r) for r in multi)
     for st in res.steps:
-        assert st.residuals[-1] <= 1e-10 * st.residuals[0]
+        assert st.residuals[-1] <= last * st.residuals[0]
+
+
+def test_newton_converges_quadratically_with_stick_slip():
+    check_quadratic_press_and_drag(*punch())
 
 
 def test_inconsistent_tangent_is_detected_by_the_newton_test():
@@ -222,26 +245,26 @@ def test_inconsistent_tangent_is_detected_by_the_newton_test():
         quadratic_last_step(r) for r in multi))
 
 
-def test_tangent_matches_finite_differences():
+def check_tangent(pr, fixed, values, seed):
     """The Newton matrix is the derivative of the internal force (mixed stick/slip/open
     state with a nonzero slip history), checked by central differences."""
-    pr, fixed, values = punch()
-    rng = np.random.default_rng(1)
+    rng = np.random.default_rng(seed)
     res = pr.solve(None, fixed, values, load_factors=[0.5, 1.0, 1.5])
     U = res.U + 2e-5 * rng.standard_normal(pr.ndofs)
-    slip = res.slip
-    f0, cs = pr.internal_force(U, slip)
-    states = set(np.unique(cs["state"]))
-    assert {STICK, SLIP} <= states
+    _, cs = pr.internal_force(U, res.slip)
+    assert {STICK, SLIP} <= set(np.unique(cs["state"]))
     A = pr.tangent(cs)
     h = 1e-10
     for _ in range(3):
         v = rng.standard_normal(pr.ndofs)
-        fp, csp = pr.internal_force(U + h * v, slip)
-        fm, csm = pr.internal_force(U - h * v, slip)
+        fp, csp = pr.internal_force(U + h * v, res.slip)
+        fm, csm = pr.internal_force(U - h * v, res.slip)
         assert np.array_equal(csp["state"], cs["state"]) and np.array_equal(csm["state"], cs["state"])
-        fd = (fp - fm) / (2 * h)
-        assert np.linalg.norm(fd - A @ v) <= 1e-6 * np.linalg.norm(A @ v)
+        assert np.linalg.norm((fp - fm) / (2 * h) - A @ v) <= 1e-6 * np.linalg.norm(A @ v)
+
+
+def test_tangent_matches_finite_differences():
+    check_tangent(*punch(), seed=1)
 
 
 # ---------------------------------------------------------------- failures and projection
@@ -254,9 +277,7 @@ def test_failure_is_reported_not_silent():
     upper = ElasticBody(rectangle_mesh(0, 2, 0.01, 1, 4, 3), E, NU)
     lower = ElasticBody(rectangle_mesh(0, 2, -1, 0, 5, 3), E, NU)
     pr = TwoBodyContact(upper, lower, "bottom", "top", eps_n=EPS)
-    fixed = np.concatenate([pr.dofs_on("master", "bottom", 1), pr.dofs_at("master", (0, -1), 0),
-                            pr.dofs_at("slave", (0, 1), 0)])
-    res = pr.solve(pr.traction_load("slave", "top", (0.0, -Q)), fixed)
+    res = pr.solve(pr.traction_load("slave", "top", (0.0, -Q)), supports(pr))
     assert not res.converged and "singular" in res.reason
 
 
@@ -319,6 +340,25 @@ def test_bad_input_elsewhere():
         pr.dofs_on("third", "top")
 
 
+def figure_4_13_supports(pr, lift=5e-4):
+    """(fixed, values) of the Figure 4.13 scenes: the slave's top fixed, the master's
+    bottom lifted by ``lift``."""
+    top = pr.dofs_on("slave", "top")
+    bx, by = pr.dofs_on("master", "bottom", 0), pr.dofs_on("master", "bottom", 1)
+    fixed = np.concatenate([top, bx, by])
+    return fixed, np.concatenate([np.zeros(top.size + bx.size), np.full(by.size, lift)])
+
+
+def check_figure_4_13(pr, res, tol=1e-9):
+    """Coulomb's bound |t_t| <= 0.1 p_n, and the slave's vertical equilibrium: the
+    reaction at its top equals the contact force (to ``tol`` relative)."""
+    assert np.all(np.abs(res.t_t) <= 0.1 * res.p_n * (1 + 1e-12))
+    fint, _ = pr.internal_force(res.U, res.slip)
+    ty = pr.dofs_on("slave", "top", 1)
+    force = np.sum(res.weights * (res.p_n * pr.normals[:, 1] - res.t_t * pr.tangents[:, 1]))
+    assert force > 0 and abs(np.sum(fint[ty]) + force) <= tol * force
+
+
 def test_figure_4_13_setup_smoke():
     """The scene of Figures 4.13-4.16 (uniform mesh only, no adaptivity): slave
     [-1/2, 1/2] x [0, 2] (top fixed), master [-2, 2] x [-2, 0] (bottom lifted by 5e-4),
@@ -330,10 +370,7 @@ def test_figure_4_13_setup_smoke():
     h = 0.25
     pr = TwoBodyContact(slave, master, ["bottom", "left", "right"], ["top", "left", "right"],
                         eps_n=1e-5 * h, eps_t=1e-5 * h, mu_f=0.1)
-    top = pr.dofs_on("slave", "top")
-    bx, by = pr.dofs_on("master", "bottom", 0), pr.dofs_on("master", "bottom", 1)
-    fixed = np.concatenate([top, bx, by])
-    vals = np.concatenate([np.zeros(top.size + bx.size), np.full(by.size, 5e-4)])
+    fixed, vals = figure_4_13_supports(pr)
     res = pr.solve(None, fixed, vals, load_factors=np.linspace(0.2, 1.0, 5))
     assert res.converged, res.reason
     assert max(res.iterations) <= 4
@@ -342,13 +379,7 @@ def test_figure_4_13_setup_smoke():
     # slave side points (x = +-1/2, y > 0) are open
     side = np.abs(np.abs(res.points[:, 0]) - 0.5) < 1e-12
     assert np.all(res.state[side] == OPEN)
-    # vertical equilibrium of the slave: reaction at its top = contact force
-    fint, _ = pr.internal_force(res.U, res.slip)
-    ty = pr.dofs_on("slave", "top", 1)
-    force = np.sum(res.weights * (res.p_n * pr.normals[:, 1] - res.t_t * pr.tangents[:, 1]))
-    assert force > 0
-    assert abs(np.sum(fint[ty]) + force) <= 1e-9 * force
-    assert np.all(np.abs(res.t_t) <= 0.1 * res.p_n * (1 + 1e-12))
+    check_figure_4_13(pr, res)
 
 
 # ================================================================ boundary element bodies
@@ -409,10 +440,6 @@ def test_contact_patch_test_with_boundary_elements(combo, p):
     # one sparse matrix with the BE block inside; BE/BE stays dense
     assert isinstance(pr.K, np.ndarray if combo == ("BE", "BE") else type(pr.Gn))
     res = patch_solve(pr)
-    assert res.converged, res.reason
-    assert np.all(res.state != OPEN)
-    assert np.max(np.abs(res.p_n / Q - 1)) < TOL
-    assert abs(np.sum(res.weights * res.p_n) / (2 * Q) - 1) < TOL
     uex = exact_uniaxial(pr)
     assert np.max(np.abs(res.U - uex)) < TOL * np.abs(uex).max()
     # the second load step (same active set) is solved by one Newton step to rounding
@@ -433,35 +460,12 @@ def test_contact_patch_test_with_boundary_elements(combo, p):
 
 @pytest.mark.parametrize("combo", [("BE", "FE"), ("FE", "BE")])
 def test_stick_below_coulomb_bound_fe_be(combo):
-    pr = mixed_blocks(combo, 2, mu_f=MU)
-    tau = 0.5 * MU * Q
-    fixed = np.concatenate([pr.dofs_on("master", "bottom", 1), pr.dofs_at("master", (0, -1), 0)])
-    res = pr.solve(shear_loads(pr, tau, (tau, -Q)), fixed, None, load_factors=[0.5, 1.0])
-    assert res.converged, res.reason
-    assert np.all(res.state == STICK)
-    assert np.max(np.abs(res.p_n / Q - 1)) < TOL
-    assert np.max(np.abs(res.t_t / tau - 1)) < TOL
-    assert np.all(np.abs(res.t_t) < MU * res.p_n)
-    assert np.max(np.abs(res.g_t / (EPS * tau) - 1)) < 1e-6
+    check_stick(mixed_blocks(combo, 2, mu_f=MU), [0.5, 1.0])
 
 
 @pytest.mark.parametrize("combo", [("BE", "FE"), ("FE", "BE"), ("BE", "BE")])
 def test_slip_at_coulomb_bound_fe_be(combo):
-    pr = mixed_blocks(combo, 1, mu_f=MU)
-    tau, c = MU * Q, 2e-3
-    exx, _ = uniaxial_strains("strain")
-    top = pr.dofs_on("slave", "top", 0)
-    base = np.concatenate([pr.dofs_on("master", "bottom", 1), pr.dofs_at("master", (0, -1), 0)])
-    fixed = np.concatenate([base, top])
-    vals = np.concatenate([np.zeros(base.size), exx * pr.dof_coordinates()[top, 0] + c])
-    res = pr.solve(shear_loads(pr, tau, (0.0, -Q)), fixed, vals, load_factors=[0.5, 1.0])
-    assert res.converged, res.reason
-    assert np.all(res.state == SLIP)
-    assert np.max(np.abs(res.p_n / Q - 1)) < TOL
-    assert np.max(np.abs(res.t_t / (MU * res.p_n) - 1)) < TOL
-    assert np.allclose(res.slip, res.g_t - EPS * res.t_t, rtol=0, atol=1e-12 * c)
-    gamma = tau / (E / (2 * (1 + NU)))
-    assert np.max(np.abs(res.g_t / (c - 2 * gamma) - 1)) < TOL
+    check_slip(mixed_blocks(combo, 1, mu_f=MU), [0.5, 1.0])
 
 
 def be_punch(master="FE", p=2):
@@ -470,17 +474,8 @@ def be_punch(master="FE", p=2):
     lower = (ElasticBody(rectangle_mesh(0, 2, -1, 0, 10, 5, "tri"), E, NU) if master == "FE"
              else be_rect(0, 2, -1, 0, [10, 5, 10, 5], p))
     upper = be_rect(0.5, 1.5, 0, 1, [6, 4, 6, 4], p)
-    pr = TwoBodyContact(upper, lower, "bottom", "top", eps_n=EPS, eps_t=EPS, mu_f=MU)
-    d, s = 1e-3, 1.5e-3
-    tx, ty = pr.dofs_on("slave", "top", 0), pr.dofs_on("slave", "top", 1)
-    clamp = pr.dofs_on("master", "bottom")
-    fixed = np.concatenate([clamp, tx, ty])
-
-    def values(lam):
-        return np.concatenate([np.zeros(clamp.size), np.full(tx.size, s * max(lam - 1, 0)),
-                               np.full(ty.size, -d * min(lam, 1))])
-
-    return pr, fixed, values
+    return press_and_drag(TwoBodyContact(upper, lower, "bottom", "top", eps_n=EPS,
+                                         eps_t=EPS, mu_f=MU))
 
 
 @pytest.mark.parametrize("master", ["FE", "BE"])
@@ -489,35 +484,12 @@ def test_newton_converges_quadratically_be_punch(master):
     (FE master, p = 2): 1 iteration per pressing step (residual 1e2 -> 1e-13), 3 in the
     shear steps, e.g. 9.9e1, 1.4e0, 3.7e-1, 2.2e-13 (active/stick sets found, then the
     piecewise linear problem is solved exactly); BE master: 9.9e1, 4.2e-1, 1.7e-1, 1.6e-13."""
-    pr, fixed, values = be_punch(master)
-    res = pr.solve(None, fixed, values, load_factors=np.linspace(0.25, 2.0, 8))
-    assert res.converged, res.reason
-    assert max(res.iterations) <= 4
-    assert any(st.counts["stick"] > 0 and st.counts["slip"] > 0 for st in res.steps)
-    assert np.all(res.state == SLIP)
-    assert np.max(np.abs(np.abs(res.t_t) - MU * res.p_n)) <= 1e-9 * MU * res.p_n.max()
-    multi = [st.residuals for st in res.steps if st.iterations >= 2]
-    assert multi and all(quadratic_last_step(r) for r in multi)
-    for st in res.steps:
-        assert st.residuals[-1] <= 1e-12 * st.residuals[0]
+    check_quadratic_press_and_drag(*be_punch(master), last=1e-12)
 
 
 def test_tangent_matches_finite_differences_be():
     """Consistent Newton matrix with a dense BE block (BE slave on a BE master)."""
-    pr, fixed, values = be_punch("BE", p=2)
-    rng = np.random.default_rng(2)
-    res = pr.solve(None, fixed, values, load_factors=[0.5, 1.0, 1.5])
-    U = res.U + 2e-5 * rng.standard_normal(pr.ndofs)
-    f0, cs = pr.internal_force(U, res.slip)
-    assert {STICK, SLIP} <= set(np.unique(cs["state"]))
-    A = pr.tangent(cs)
-    h = 1e-10
-    for _ in range(3):
-        v = rng.standard_normal(pr.ndofs)
-        fp, csp = pr.internal_force(U + h * v, res.slip)
-        fm, csm = pr.internal_force(U - h * v, res.slip)
-        assert np.array_equal(csp["state"], cs["state"]) and np.array_equal(csm["state"], cs["state"])
-        assert np.linalg.norm((fp - fm) / (2 * h) - A @ v) <= 1e-6 * np.linalg.norm(A @ v)
+    check_tangent(*be_punch("BE", p=2), seed=2)
 
 
 def test_be_adapter_bad_input():
@@ -544,17 +516,15 @@ def figure_4_13_coarse():
     master = ElasticBody(rectangle_mesh(-2, 2, -2, 0, 8, 4, "tri"), E, NU)
     pr = TwoBodyContact(slave, master, ["bottom", "left", "right"], ["top", "left", "right"],
                         eps_n=1 / (10 * E), eps_t=1 / (5 * E), mu_f=0.1)
-    top = pr.dofs_on("slave", "top")
-    bx, by = pr.dofs_on("master", "bottom", 0), pr.dofs_on("master", "bottom", 1)
-    fixed = np.concatenate([top, bx, by])
-    vals = np.concatenate([np.zeros(top.size + bx.size), np.full(by.size, 5e-4)])
+    fixed, vals = figure_4_13_supports(pr)
     return pr, fixed, vals
 
 
 def test_line_search_breaks_the_two_state_newton_cycle():
     """Plain semismooth Newton cycles between two stick/slip states in the first load
-    step (measured residuals 9.6e1, 7.4e-1, 1.0e0, 1.667, 1.656, 1.667, 1.656, ...).
-    With the Armijo backtracking on ||R_free|| (the residual is piecewise linear in U,
+    step (measured residuals 9.6e1, 7.4e-1, 1.0e0, 1.667, 1.656, 1.667, 1.656, ...);
+    the cycle is detected without a line search too and reported as "cycling" at the
+    repeated contact state (before, it ran to max_iter).  With the Armijo backtracking on ||R_free|| (the residual is piecewise linear in U,
     so along the Newton direction of the current piece it decreases like (1 - alpha)
     for small alpha: the search always succeeds and the residual decreases monotonically,
     which excludes the cycle) it converges: measured 7 iterations, step lengths
@@ -563,9 +533,9 @@ def test_line_search_breaks_the_two_state_newton_cycle():
     pr, fixed, vals = figure_4_13_coarse()
     lf = np.linspace(0.2, 1.0, 5)
     plain = pr.solve(None, fixed, vals, load_factors=lf, settings=ContactSettings(max_iter=20))
-    assert not plain.converged and "max_iter" in plain.reason
-    r = np.asarray(plain.steps[0].residuals[-6:])
-    assert np.allclose(r[:-2], r[2:], rtol=1e-6)            # period-2 cycle
+    assert not plain.converged and "cycling" in plain.reason
+    r = np.asarray(plain.steps[0].residuals)
+    assert r.size < 20 and r[-1] > 1e-3 * r[0]               # stopped at the cycle
     res = pr.solve(None, fixed, vals, load_factors=lf, settings=ContactSettings(max_iter=20, line_search=True))
     assert res.converged, res.reason
     assert max(res.iterations) <= 10
@@ -575,14 +545,9 @@ def test_line_search_breaks_the_two_state_newton_cycle():
     assert all(np.all(np.diff(st.residuals) < 0) for st in res.steps)   # monotone
     for st in res.steps:
         assert st.residuals[-1] <= 1e-10 * st.residuals[0]
-    assert np.all(np.abs(res.t_t) <= 0.1 * res.p_n * (1 + 1e-12))
     last = res.steps[-1]
     assert last.counts["stick"] > 0 and last.counts["slip"] > 0
-    # equilibrium: the reaction at the slave's top equals the contact force
-    fint, _ = pr.internal_force(res.U, res.slip)
-    ty = pr.dofs_on("slave", "top", 1)
-    force = np.sum(res.weights * (res.p_n * pr.normals[:, 1] - res.t_t * pr.tangents[:, 1]))
-    assert force > 0 and abs(np.sum(fint[ty]) + force) <= 1e-9 * force
+    check_figure_4_13(pr, res)
 
 
 def test_line_search_keeps_full_steps_when_they_decrease_the_residual():
@@ -625,10 +590,7 @@ def test_figure_4_13_coarse_with_boundary_elements(combo):
     assert np.isclose(2 / 4, h)
     pr = TwoBodyContact(s, m, ["bottom", "left", "right"], ["top", "left", "right"],
                         eps_n=1 / (10 * E), eps_t=1 / (5 * E), mu_f=0.1)
-    top = pr.dofs_on("slave", "top")
-    bx, by = pr.dofs_on("master", "bottom", 0), pr.dofs_on("master", "bottom", 1)
-    fixed = np.concatenate([top, bx, by])
-    vals = np.concatenate([np.zeros(top.size + bx.size), np.full(by.size, 5e-4)])
+    fixed, vals = figure_4_13_supports(pr)
     lf = np.linspace(0.2, 1.0, 5)
     # whether plain Newton cycles on this scene depends on round-off (it converged with
     # numpy 2.4 / OpenBLAS here, on the old and the new code alike): not asserted
@@ -639,11 +601,7 @@ def test_figure_4_13_coarse_with_boundary_elements(combo):
     assert all(st.residuals[-1] <= 1e-10 * st.residuals[0] for st in res.steps)
     side = np.abs(np.abs(res.points[:, 0]) - 0.5) < 1e-12
     assert np.all(res.state[side] == OPEN) and np.any(res.state == SLIP)
-    assert np.all(np.abs(res.t_t) <= 0.1 * res.p_n * (1 + 1e-12))
-    fint, _ = pr.internal_force(res.U, res.slip)
-    ty = pr.dofs_on("slave", "top", 1)
-    force = np.sum(res.weights * (res.p_n * pr.normals[:, 1] - res.t_t * pr.tangents[:, 1]))
-    assert force > 0 and abs(np.sum(fint[ty]) + force) <= 1e-8 * force
+    check_figure_4_13(pr, res, tol=1e-8)
 
 
 def test_plastic_tangent_is_lazy_and_lu_orderings_reuse():

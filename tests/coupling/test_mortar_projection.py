@@ -8,19 +8,17 @@ from scipy.optimize import lsq_linear
 from hpfebe.solvers import projected_cg
 from hpfebe.coupling.mortar import MortarProjection
 from hpfebe.geometry import BoundaryMesh
+from hpfebe.scenes import model_meshes
 from hpfebe.spaces import ContinuousSpace
 
 
-def _arc_mesh(n, p, radius=5.05):
-    half = np.arcsin(1.0 / radius)
-    ang = np.linspace(-half, half, n + 1)
-    arc = np.column_stack([radius * np.sin(ang), radius - radius * np.cos(ang)])
-    verts = np.vstack([arc, [[1.0, 2.0], [-1.0, 2.0]]])
-    return BoundaryMesh.polygon(verts, n=[1] * n + [3, 4, 3], labels=["C"] * n + ["N", "D", "N"],
-                                p=p)
+def _meshes(n1, n2, p1, p2):
+    """The arc body and the box of the model problem of Section 4.3.4 (Gamma^1_C the
+    arc's polygon, n1 elements of degree p1; Gamma^2_C straight, n2 of degree p2)."""
+    return model_meshes(n1, n2, p1, p2)[:2]
 
 
-def _box_mesh(n, p, x0=-1.0, x1=1.0):
+def _shifted_box(n, p, x0, x1):
     return BoundaryMesh.polygon([(x0, -2), (x1, -2), (x1, 0), (x0, 0)], n=[3, 3, n, 3],
                                 labels=["D", "D", "C", "D"], p=p)
 
@@ -30,7 +28,7 @@ def _box_mesh(n, p, x0=-1.0, x1=1.0):
 def test_reproduces_polynomials(p1, p2, n1, n2):
     """Polynomials in x of degree <= min(p1, p2) are reproduced on non-matching meshes
     (arc polygon vs straight line, paired by the x-coordinate)."""
-    m = MortarProjection(_arc_mesh(n1, p1), _box_mesh(n2, p2))
+    m = MortarProjection(*_meshes(n1, n2, p1, p2))
     s1, s2 = m.space1, m.space2
     for deg in range(min(p1, p2) + 1):
         coef = np.arange(1, deg + 2) * (-0.7) ** np.arange(deg + 1)
@@ -44,7 +42,7 @@ def test_reproduces_polynomials(p1, p2, n1, n2):
 
 
 def test_defining_identity_and_adjoint():
-    m = MortarProjection(_arc_mesh(9, 2), _box_mesh(7, 3))
+    m = MortarProjection(*_meshes(9, 7, 2, 3))
     rng = np.random.default_rng(0)
     phi2 = rng.standard_normal(m.dofs2.size)
     psi1 = rng.standard_normal(m.dofs1.size)
@@ -64,9 +62,9 @@ def test_defining_identity_and_adjoint():
 
 
 def test_bad_input():
-    a, b = _arc_mesh(4, 1), _box_mesh(3, 1)
+    a, b = _meshes(4, 3, 1, 1)
     with pytest.raises(ValueError, match="overlap"):
-        MortarProjection(a, _box_mesh(3, 1, 3.0, 5.0))
+        MortarProjection(a, _shifted_box(3, 1, 3.0, 5.0))
     with pytest.raises(ValueError, match="label1"):
         MortarProjection(a, b, label1="X")
     with pytest.raises(ValueError, match="axis"):

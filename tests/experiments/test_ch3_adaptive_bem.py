@@ -5,8 +5,6 @@ decided, the published numbers met.  The numerics are tested in the core
 
 from __future__ import annotations
 
-import logging
-
 import numpy as np
 import pytest
 
@@ -89,3 +87,12 @@ def test_wrong_config_is_rejected(tmp_path, capsys, section, match):
     assert rc == cli.EXIT_USAGE             # a config error is a usage error (exit 2)
     err = capsys.readouterr().err
     assert match in err and "bad.yaml" in err
+
+
+def test_paraview_exports_of_the_final_state(quick_run):
+    """Figs. 3.4 and 3.8 export the last adaptive mesh (U, eta) and its contact state
+    along Gamma_C (pressure, tangential traction, slip, state) for ParaView."""
+    for name in ("figure_3_4", "figure_3_8"):
+        exports = quick_run[name][0]["exports"]
+        assert sorted(e.rsplit("/", 1)[-1] for e in exports) == [
+            f"{name}_final_contact.vtu", f"{name}_final_mesh.vtu"], exports

@@ -137,9 +137,9 @@ def test_quick_run_produces_all_artefacts(quick_run):
         assert (out / f"{name}.png").is_file()
         assert js["claims"] and all(c["holds"] is not None for c in js["claims"]), name
         assert js["meta"]["run_s"] < 60
-    vtus = sorted(p.name for p in out.glob("*.vtu"))
+    vtus = sorted(p.name for p in (out / "vtu").glob("*.vtu"))
     assert len(vtus) == 4 and all(v.startswith("figure_4_16_") for v in vtus), vtus
-    assert np.all(np.isfinite(meshio.read(out / vtus[0]).point_data["displacement"]))
+    assert np.all(np.isfinite(meshio.read(out / "vtu" / vtus[0]).point_data["displacement"]))
 
 
 def test_claim_kinds_and_links(quick_run):

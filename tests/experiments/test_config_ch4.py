@@ -15,11 +15,12 @@ ROOT = Path(__file__).resolve().parents[2]
 if str(ROOT) not in sys.path:        # as `hpfebe run` does: the suite's experiments/
     sys.path.insert(0, str(ROOT))
 
-from experiments.ch4_section44.dtn import (READING_TEXT, mortar_claims,  # noqa: E402
+from experiments.ch4_section44.dtn import (PUBLISHED_42, mortar_claims,  # noqa: E402
                                            readings_claim)
-from experiments.ch4_section44.scene import Params, _published_42  # noqa: E402
 
 from hpfebe import cli  # noqa: E402
+from hpfebe.scenes.section44 import READING_TEXT, Section44Scene  # noqa: E402
+from hpfebe.suite import published_table  # noqa: E402
 
 #: (job, key, bad value): the nested keys of issue 25 and the tolerances that are never
 #: reached when <= 0 (run in-process through the CLI's own entry point, as `hpfebe run`)
@@ -58,14 +59,14 @@ def test_bad_value_exits_2_naming_key_and_file(tmp_path, capsys, monkeypatch, jo
 def test_section44_claims_over_no_converged_run_are_open():
     """Table 4.2's claims over the converged runs are undecided (holds None), not held,
     when no DtN run converged (issue 25: newton_tol -1 claimed 'holds' over no run)."""
-    pub = _published_42()
+    pub = published_table(PUBLISHED_42)
     tab = pub[["omega_D", "omega_N"]].assign(       # every run failed, as mortar_sweep has it
         dtn_iterations=np.nan, dtn_iterations_alt_tol=np.nan,
         uzawa_iterations_first_dtn=np.nan, converged=False, reason="newton: not converged",
         uzawa_first_run=3, uzawa_max_later=0, dtn_steps_run=1,
         **{f"its_{name}": np.nan for name in READING_TEXT})
-    claims = {c.id: c for c in mortar_claims(Params(), tab, pub)}
-    claims["readings"] = readings_claim(Params(), tab, pub)
+    claims = {c.id: c for c in mortar_claims(Section44Scene(), tab, pub)}
+    claims["readings"] = readings_claim(Section44Scene(), tab, pub)
     for cid in ("counts", "alt_tol", "uzawa_later", "readings"):
         assert claims[cid].holds is None, (cid, claims[cid].evidence)
     assert claims["no_convergence"].holds is False

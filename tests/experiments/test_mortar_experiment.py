@@ -15,7 +15,9 @@ if str(ROOT) not in sys.path:        # as `hpfebe run` does: the suite's experim
     sys.path.insert(0, str(ROOT))
 
 import experiments.ch4_mortar as m  # noqa: E402
-from experiments.ch4_mortar import scene, table  # noqa: E402
+from experiments.ch4_mortar import table  # noqa: E402
+
+from hpfebe.scenes.mortar_runs import PUBLISHED_TABLE  # noqa: E402
 
 
 def _quick_config() -> dict:
@@ -78,7 +80,7 @@ def test_symmetry_explanation_links_only_the_off_cells():
     our counts are symmetric there in both readings."""
     rows = [dict(omega_D=a, omega_N=b, iterations=float(v or np.nan), converged=v is not None,
                  iterations_tresca=float(v or np.nan))
-            for (a, b), v in scene.PUBLISHED_TABLE.items()]
+            for (a, b), v in PUBLISHED_TABLE.items()]
     df = pd.DataFrame(rows)
     df.loc[(df.omega_D == 0.3) & (df.omega_N == 0.9), ["iterations", "iterations_tresca"]] = 23.0
     c = table._symmetry_claim(df, [(0.3, 0.9)])

@@ -177,10 +177,11 @@ def test_continuum_tangent_converges_slower():
 
 @pytest.mark.parametrize("formulation", ["bbar", "full"])
 @pytest.mark.parametrize("tg", ["algorithmic", "continuum"])
-def test_tangent_from_plastic_elements_equals_full_assembly_bitwise(formulation, tg):
+def test_tangent_from_plastic_elements_equals_full_assembly(formulation, tg):
     """The tangent assembled from the plastic elements only (elastic element matrices
-    elsewhere) and the lazy tangent are the full assembly of the pointwise tangent, bit
-    for bit (our own code both ways); the strain and force kernels are the einsum
+    elsewhere, the fused kernel of tr_i tr_j, G_ij, m_i m_j) and the lazy tangent are the
+    full assembly of the pointwise tangent of return_map to round-off (64 eps of the
+    largest entry; the same pattern, that of K); the strain and force kernels are the einsum
     contractions to the rounding bound of their sums, gamma_n sum |terms| with n the
     number of terms (einsum's summation order depends on the CPU's SIMD width)."""
     fe = ElastoPlasticFE(rectangle_mesh(-2, 2, -3, -1, 8, 4, "quad"), MAT, formulation,
@@ -196,7 +197,9 @@ def test_tangent_from_plastic_elements_equals_full_assembly_bitwise(formulation,
     for A in (T, fe.internal_force_lazy(u)[1]()):
         np.testing.assert_array_equal(A.indptr, ref.indptr)
         np.testing.assert_array_equal(A.indices, ref.indices)
-        np.testing.assert_array_equal(A.data, ref.data)
+        assert np.shares_memory(A.indices, fe.K.indices)        # the fixed pattern of K
+        assert np.abs(A.data - ref.data).max() <= 64 * np.finfo(float).eps * \
+            np.abs(ref.data).max()
     ue = u[fe.element_dofs].T
     u_r = np.finfo(float).eps / 2
 

@@ -70,3 +70,42 @@ def test_settings_store_plain_python_values():
     assert (type(s.rtol), type(s.max_iter), type(s.max_cuts), type(s.predictor)) == \
         (float, int, int, bool)
     assert s.max_cuts == 2 and s.predictor is True
+
+
+def _solver_settings():
+    from hpfebe.contact.mortar_fe import NeumannSettings
+    from hpfebe.solvers import (DtNSettings, GlobalUzawaSettings, SemismoothSettings,
+                                UzawaSettings)
+    return [lambda t: ContactSettings(rtol=t), lambda t: DtNSettings(0.5, 0.5, t),
+            lambda t: UzawaSettings(tol=t), lambda t: UzawaSettings(cg_tol=t),
+            lambda t: GlobalUzawaSettings(tol=t), lambda t: SemismoothSettings(tol=t),
+            lambda t: NeumannSettings(t)]
+
+
+@pytest.mark.parametrize("k", range(7))
+@pytest.mark.parametrize("tol", [1.0, 2.0, 0.0, np.inf])
+def test_relative_tolerances_lie_in_0_1(k, tol):
+    """A relative tolerance >= 1 accepted a residual as large as the forces it is
+    measured against: SemismoothSettings(tol=2) and FEMortarContact.monolithic(tol=2)
+    reported "converged" on the mortar scenes.  Every stopping tolerance of Chapter 4
+    is a real in (0, 1) (:func:`hpfebe.checks.tolerance`)."""
+    with pytest.raises(ValueError, match=r"tol must be a finite real number in \(0, 1\)"):
+        _solver_settings()[k](tol)
+
+
+def test_dirichlet_data_and_dofs_are_numbers():
+    from hpfebe.bodies.plastic_be import DirichletSolver, rectangle_work_piece
+    from hpfebe.contact import MortarContact
+    from hpfebe.scenes import model_meshes
+    m1, m2, normal = model_meshes(4, 3, 1, 1)
+    b1, b2 = LameBEM(m1, E, NU), LameBEM(m2, E, NU)
+    for value, err in ((("1", 0.0), "InputTypeError"), ((np.nan, 0.0), "ValueError")):
+        with pytest.raises(ValueError, match=r"dirichlet1 must be \(label, \(Ux, Uy\)\) "
+                                             r"with finite real Ux, Uy") as info:
+            MortarContact(b1, b2, ("D", value), ("D", (0.0, 0.0)), 0.1, normal=normal)
+        assert type(info.value).__name__ == err
+    be = rectangle_work_piece((0, 1, 0, 1), 2, 2, J2Material(E, NU, SY, H))
+    with pytest.raises(ValueError, match=r"fixed must hold integers, got 1.5"):
+        DirichletSolver(be, [0, 1.5], 0.0)          # was truncated to dof 1
+    with pytest.raises(ValueError, match="values must be a scalar or one value per"):
+        DirichletSolver(be, [0, 1], [0.0, 0.0, 0.0])

@@ -11,7 +11,8 @@ from hpfebe.bem.lame import LameBEM
 from hpfebe.contact import MortarContact
 from hpfebe.coupling.mortar import MortarProjection
 from hpfebe.geometry import BoundaryMesh
-from hpfebe.scenes import dtn_settings, model_meshes, model_problem, section44_scene
+from hpfebe.scenes import (ModelProblem, dtn_settings, model_meshes, model_problem,
+                           section44_scene)
 from hpfebe.scenes.materials import E, NU, PLANE
 from hpfebe.solvers import (DtNSettings, GlobalUzawaSettings, SemismoothSettings,
                             UzawaSettings)
@@ -23,7 +24,7 @@ def _shifted(mesh, dx):
 
 @pytest.fixture(scope="module")
 def coarse():
-    return model_problem(n1=4, n2=3, p1=1, p2=1)
+    return model_problem(ModelProblem(n1=4, n2=3, p1=1, p2=1))
 
 
 # ------------------------------------------------------------------ coverage
@@ -143,9 +144,10 @@ def test_tiny_lift_scales_linearly(solver):
     (lambda: SemismoothSettings(max_iter="100"), "max_iter", TypeError),
     (lambda: SemismoothSettings(friction="Coulomb "), "friction", ValueError),
     (lambda: dtn_settings(0.5, 0.5, rho="8e5"), "rho", TypeError),
-    (lambda: model_problem(n1=4, n2=3, p1=1, p2=1, F="0.1"), "F", TypeError),
-    (lambda: model_problem(n1=4.5), "n1", ValueError),
-    (lambda: model_problem(n1=4, n2=3, p1=1, p2=1, u_top=(0.0, "x")), "u_top", TypeError),
+    (lambda: model_problem(ModelProblem(n1=4, n2=3, p1=1, p2=1, F="0.1")), "F", TypeError),
+    (lambda: model_problem(ModelProblem(n1=4.5)), "n1", ValueError),
+    (lambda: model_problem(ModelProblem(n1=4, n2=3, p1=1, p2=1, u_top=(0.0, "x"))),
+     "u_top", TypeError),
     (lambda: section44_scene((4, 8), (16, 8), lift="1e-4"), "lift", TypeError),
 ])
 def test_coercion_refused(make, match, kind):
@@ -186,3 +188,34 @@ def test_wrong_objects_refused(coarse, case):
         sc = section44_scene((4, 8), (16, 8), formulation="full")
         with pytest.raises(TypeError, match="F must"):
             sc.dtn(dtn_settings(0.5, 0.7), F="0")
+
+
+@pytest.mark.parametrize("case", ["gap_scalar", "gap_nan", "lam0_nan", "settings_none",
+                                  "global_settings", "dtn_settings", "frame_length"])
+def test_more_wrong_objects_named(coarse, case):
+    """A constant gap given as a float failed with "'float' object is not callable", a
+    NaN lam0 was named x0 (the CG's start), settings=None raised an AttributeError and
+    a vector of the wrong length to frame a reshape error: each now names its
+    parameter."""
+    pr = coarse
+    m1, m2, normal = model_meshes(4, 3, 1, 1)
+    b1, b2 = LameBEM(m1, E, NU, PLANE), LameBEM(m2, E, NU, PLANE)
+    data = (("D", (0.0, -0.09)), ("D", (0.0, 0.0)), 0.1)
+    cases = {
+        "gap_scalar": (lambda: MortarContact(b1, b2, *data, normal=normal, gap=0.0),
+                       "gap must be a callable, got 0.0"),
+        "gap_nan": (lambda: MortarContact(b1, b2, *data, normal=normal,
+                                          gap=lambda x: np.full(len(x), np.nan)),
+                    r"gap\(x\) must be finite, got nan"),
+        "lam0_nan": (lambda: pr.uzawa(np.zeros(2 * pr.nc), lam0=np.full(pr.nc, np.nan)),
+                     "lam0 must be finite"),
+        "settings_none": (lambda: pr.semismooth_newton(None),
+                          "settings must be a SemismoothSettings"),
+        "global_settings": (lambda: pr.global_uzawa(UzawaSettings()),
+                            "settings must be a GlobalUzawaSettings"),
+        "dtn_settings": (lambda: pr.dtn(UzawaSettings()), "settings must be a DtNSettings"),
+        "frame_length": (lambda: pr.frame(np.zeros(3)),
+                         rf"v must be {2 * pr.nc} numbers .* got \(3,\)")}
+    make, match = cases[case]
+    with pytest.raises(ValueError, match=match):
+        make()

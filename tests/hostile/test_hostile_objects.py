@@ -1,7 +1,8 @@
 """Issue 25, class "wrong objects": a LaplaceBEM where a Lame body is expected, a gap
 callable returning a scalar, densities of the wrong length and points on Gamma in the
-representation formula: each a ValueError (or InputTypeError, also a ValueError) that
-names the parameter, what it got and what is allowed."""
+representation formula, one body given as both contact bodies: each a ValueError (or
+InputTypeError, also a ValueError) that names the parameter, what it got and what is
+allowed."""
 
 import numpy as np
 import pytest
@@ -12,7 +13,11 @@ from hpfebe.bem.laplace import LaplaceBEM
 from hpfebe.bem.potentials import PointOnBoundaryError
 from hpfebe.bodies import BEBody, RigidObstacle, as_body
 from hpfebe.checks import InputTypeError
+from hpfebe.constitutive.j2 import J2Material
+from hpfebe.contact import MortarContact
+from hpfebe.contact.mortar_fe import FEMortarContact
 from hpfebe.contact.two_body import TwoBodyContact
+from hpfebe.fem import ElasticBody, ElastoPlasticFE, rectangle_mesh
 
 SQUARE = [(0, 0), (1, 0), (1, 1), (0, 1)]
 MESH = BoundaryMesh.polygon(SQUARE, n=2, p=2, labels=["C", "N", "D", "N"])
@@ -77,3 +82,22 @@ def test_representation_at_a_boundary_point_names_it(op, point):
     # a ValueError for the hostile-input contract, a FloatingPointError as before
     assert issubclass(PointOnBoundaryError, ValueError)
     assert issubclass(PointOnBoundaryError, FloatingPointError)
+
+
+def _fe_pair():
+    work = ElastoPlasticFE(rectangle_mesh(-2, 2, -2, 0, 4, 2), J2Material(1.0, 0.3, 1.0, 1.0))
+    return ElasticBody(rectangle_mesh(-0.5, 0.5, 0, 2, 1, 2), 1.0, 0.3), work
+
+
+@pytest.mark.parametrize("make", [
+    lambda: TwoBodyContact(LAME, LAME, "C", "C", eps_n=1e-3),
+    lambda: TwoBodyContact(LAME, BEBody(LAME), "C", "C", eps_n=1e-3),
+    lambda: MortarContact(LAME, LAME, ("D", (0.0, 0.0)), ("D", (0.0, 0.0)), 1.0),
+    lambda: (lambda w: FEMortarContact(w.elastic, w, ("top", (0, 0)), ("bottom", (0, 0)),
+                                       0.0))(_fe_pair()[1])],
+    ids=["penalty", "penalty-wrapped", "mortar", "fe-mortar"])
+def test_one_body_given_as_both_bodies(make):
+    """The same body as slave and master (or bem1 and bem2, stamp and work piece) used
+    to converge: two copies of one body overlapping by its whole height."""
+    with pytest.raises(ValueError, match=r"must be two bodies, got the same body twice"):
+        make()

@@ -16,7 +16,6 @@ floor was scaled with the data (a yield force rtol sigma_Y width), the lift 4.2e
 accepted at its start after 0 Newton iterations with a force 14.7 x the linear one.
 """
 
-import numpy as np
 import pytest
 
 from hpfebe.constitutive.j2 import J2Material

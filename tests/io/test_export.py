@@ -6,7 +6,7 @@ import pytest
 from skfem import MeshTri
 
 from hpfebe import BoundaryMesh, ContinuousSpace
-from hpfebe.io.vtu import write_boundary_vtu, write_fe_vtu
+from hpfebe.io.vtu import fe_vtu, write_boundary_vtu, write_fe_vtu, write_pvd
 
 
 def test_boundary_vtu_roundtrip(tmp_path):
@@ -92,3 +92,33 @@ def _umask():
     mask = os.umask(0)
     os.umask(mask)
     return mask
+
+
+def test_vtu_series_and_its_hook(tmp_path):
+    """write_vtu_series: <stem>_<k>.vtu per step, then <stem>.pvd naming them with their
+    times; the hook is asked before every rename, and a refusal keeps the file out."""
+    from hpfebe.io import write_vtu_series
+
+    m = MeshTri.init_symmetric()
+    steps = [(0.25, fe_vtu(m, {"u": np.full(m.p.shape[1], 1.0)})),
+             (1.0, fe_vtu(m, {"u": np.full(m.p.shape[1], 2.0)}))]
+    asked = []
+    paths = write_vtu_series(tmp_path / "s.pvd", steps, before_rename=asked.append)
+    assert [p.name for p in paths] == ["s_0.vtu", "s_1.vtu", "s.pvd"]
+    assert [p.name for p in asked] == ["s_0.vtu", "s_1.vtu", "s.pvd"]
+    text = paths[-1].read_text()
+    assert 'timestep="0.25" part="0" file="s_0.vtu"' in text
+    assert np.allclose(meshio.read(paths[1]).point_data["u"], 2.0)
+
+    def refuse(path):
+        raise KeyboardInterrupt
+
+    with pytest.raises(KeyboardInterrupt):
+        write_pvd(tmp_path / "r.pvd", [(1.0, paths[0])], before_rename=refuse)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["s.pvd", "s_0.vtu", "s_1.vtu"]
+    for bad, match in (([], "at least one"), ([(1.0, steps[0][1]), (1.0, steps[1][1])],
+                                               "strictly increasing")):
+        with pytest.raises(ValueError, match=match):
+            write_vtu_series(tmp_path / "b.pvd", bad)
+    with pytest.raises(ValueError, match="pvd"):
+        write_vtu_series(tmp_path / "b.vtu", steps)

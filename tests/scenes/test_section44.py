@@ -170,6 +170,8 @@ def test_scenes_compute_their_artefacts_only(monkeypatch):
     import experiments.ch4_section44 as m
     import yaml
 
+    from hpfebe.scenes import section44_runs
+
     assert sorted(a for arts in m.SCENES.values() for a in arts) == sorted(m.ARTEFACTS)
     cfg = yaml.safe_load((ROOT / "config/config.yaml").read_text())["ch4_section44"]
     cfg.update(yaml.safe_load((ROOT / "config/quick.yaml").read_text())["ch4_section44"])
@@ -178,7 +180,7 @@ def test_scenes_compute_their_artefacts_only(monkeypatch):
     def no_penalty(*a, **k):
         raise AssertionError("the dtn scene ran a penalty problem")
 
-    monkeypatch.setattr(m, "run_penalty", no_penalty)
+    monkeypatch.setattr(section44_runs, "run_penalty", no_penalty)
     assert [r.name for r in m.run(cfg, scenes=("dtn",))] == ["table_4_2"]
     with pytest.raises(ValueError, match="unknown scene"):
         m.run(cfg, scenes=("nope",))
@@ -263,3 +265,34 @@ def test_scene_fields_and_share():
     assert 0 < tangential_share(sc, sol) < 1
     stamp, fe = penalty_scene((16, 8), 0.5, J2Material(E, NU, 4.0, 450.0))
     assert isinstance(stamp, LameBEM) and fe.mesh.t.shape[1] == 16 * 8
+
+
+def test_scene_parameters_and_exports():
+    """Section44Scene refuses a bad value naming the parameter; a penalty run and a
+    mortar solution of a small scene go to ParaView (work piece with its element fields,
+    stamp, contact state along Gamma_C), and the colour ranges are those of the fields."""
+    from hpfebe.scenes import section44_fields, section44_runs
+    from hpfebe.scenes.section44 import Section44Scene
+
+    for bad, name in ((dict(newton_tol=0.0), "newton_tol"), (dict(omegas_D=(0.0,)), "omegas_D"),
+                      (dict(figure_factor=3.0), "figure_factor"),
+                      (dict(penalty_law="x"), "penalty_law"), (dict(max_cuts=-1), "max_cuts")):
+        with pytest.raises(ValueError, match=name):
+            Section44Scene(**bad)
+    prm = Section44Scene(work_cells=(16, 8), stamp_cells=(4, 8), h_stamp=0.5, n_load=2)
+    r = section44_runs.run_penalty(prm, 10.0)
+    assert r.result.converged, r.result.reason
+    out = section44_fields.penalty_exports(prm, r)
+    assert sorted(out) == ["contact", "stamp", "work"]
+    assert out["work"].points.shape[0] == 17 * 9
+    assert set(out["work"].cell_data) >= {"dev_sigma_norm", "eps_p_norm"}
+    assert (out["contact"].point_data["p_n"] >= 0).all()
+    rows = section44_fields.colour_ranges(r.bodies(prm.h_stamp), r.peak.fields["dev_sigma_norm"])
+    assert [(x["body"], x["field"]) for x in rows][-1] == ("work", "dev_sigma_norm")
+    assert rows[-1]["ours_max"] == r.peak.fields["dev_sigma_norm"].max()
+    sc = section44_runs.mortar_scene(prm)
+    sol = sc.monolithic()
+    assert sol.info.converged, sol.info.reason
+    out = section44_fields.mortar_exports(sc, sol)
+    assert sorted(out) == ["contact", "stamp", "work"]
+    assert out["stamp"].points.shape[0] == 5 * 9

@@ -151,7 +151,7 @@ def test_quick_run_without_out_keeps_full_results(tmp_path, monkeypatch):
 
 def test_run_names_a_job(tmp_path):
     """An artefact id runs its scene's job only; the job's rule name works too."""
-    from experiments.registry import discover
+    from hpfebe.suite.registry import discover
 
     reg = discover(ROOT / "experiments")
     job = next(j for j in reg.jobs if j.scene is not None)

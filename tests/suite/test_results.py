@@ -206,3 +206,113 @@ def test_suite_facade_is_light_and_complete():
     for name in ("Claim", "ArtefactResult", "progress", "rate_claim", "range_claim",
                  "joint_claim", "beats_uniform_claim", "from_config", "CELLS_PREFIX"):
         assert name in suite.__all__
+
+
+# --------------------------------------------------------------------------- exports
+def _mesh(shift=0.0):
+    import meshio
+    pts = np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]])
+    return meshio.Mesh(pts, [("triangle", np.array([[0, 1, 2]]))],
+                       point_data={"u": np.full(3, shift)})
+
+
+def _mode(path):
+    import os
+    import stat
+    mask = os.umask(0)
+    os.umask(mask)
+    return stat.S_IMODE(path.stat().st_mode), 0o666 & ~mask
+
+
+def test_exports_land_in_results_vtu(tmp_path):
+    """One mesh per key: <out>/vtu/<name>_<key>.vtu with the usual mode, listed in the
+    JSON relative to <out>; nothing VTU at the top of <out>; the JSON still last."""
+    import meshio
+    paths = write_result(_result(exports={"final": _mesh(2.0)}), tmp_path)
+    vtu = tmp_path / "vtu" / "table_9_1_final.vtu"
+    assert vtu in paths and paths[-1].name == "table_9_1.json"
+    assert not list(tmp_path.glob("*.vtu"))
+    assert np.allclose(meshio.read(vtu).point_data["u"], 2.0)
+    mode, usual = _mode(vtu)
+    assert mode == usual
+    doc = json.loads((tmp_path / "table_9_1.json").read_text())
+    assert doc["exports"] == ["vtu/table_9_1_final.vtu"]
+    assert sorted(p.name for p in (tmp_path / "vtu").iterdir()) == ["table_9_1_final.vtu"]
+
+
+def test_export_series_gets_a_pvd(tmp_path):
+    """A list of (load step, mesh): one VTU per step and a PVD collection (written
+    after its VTUs) that names them relative to vtu/, with the steps' times."""
+    import meshio
+    steps = [(0.5, _mesh(0.0)), (1.0, _mesh(1.0)), (2.0, _mesh(4.0))]
+    paths = write_result(_result(exports={"steps": steps, "last": _mesh(4.0)}), tmp_path)
+    d = tmp_path / "vtu"
+    names = [p.relative_to(tmp_path).as_posix() for p in paths[1:-1]]  # csv ... json
+    assert names == ["vtu/table_9_1_steps_0.vtu", "vtu/table_9_1_steps_1.vtu",
+                     "vtu/table_9_1_steps_2.vtu", "vtu/table_9_1_steps.pvd",
+                     "vtu/table_9_1_last.vtu"]
+    text = (d / "table_9_1_steps.pvd").read_text()
+    for k, (t, _) in enumerate(steps):
+        assert f'timestep="{t!r}" part="0" file="table_9_1_steps_{k}.vtu"' in text
+    assert np.allclose(meshio.read(d / "table_9_1_steps_2.vtu").point_data["u"], 4.0)
+    assert _mode(d / "table_9_1_steps.pvd")[0] == _mode(d / "table_9_1_steps.pvd")[1]
+    doc = json.loads((tmp_path / "table_9_1.json").read_text())
+    assert doc["exports"] == names
+
+
+@pytest.mark.parametrize("exports, match", [
+    ({"a b": None}, "identifier"),
+    ({"x": "not a mesh"}, "meshio.Mesh or a non-empty list"),
+    ({"x": []}, "non-empty"),
+    ({"x": [(1.0, "mesh")]}, "meshio.Mesh"),
+    ({"x": [(1.0, None), (0.5, None)]}, "meshio.Mesh"),
+])
+def test_bad_exports_refused_before_writing(tmp_path, exports, match):
+    with pytest.raises(ValueError, match=match):
+        write_result(_result(exports=exports), tmp_path)
+    assert not list(tmp_path.iterdir())
+
+
+def test_series_times_must_increase(tmp_path):
+    for times in ((1.0, 1.0), (2.0, 1.0), (0.0, float("nan")), (True, 2.0)):
+        with pytest.raises(ValueError, match="strictly increasing"):
+            write_result(_result(exports={"s": [(t, _mesh()) for t in times]}), tmp_path)
+    assert not list(tmp_path.iterdir())
+
+
+def test_exports_ask_the_job_watch_before_every_rename(tmp_path, monkeypatch):
+    """The before_rename hook of the job watch is called for every VTU and PVD; when it
+    raises (the parent Snakemake is gone) the file does not land and no temporary is
+    left."""
+    from hpfebe.suite import watch
+    asked = []
+
+    def hook(path):
+        asked.append(path.name)
+        if path.suffix == ".pvd":
+            raise watch.Terminated(15, "parent gone")
+
+    monkeypatch.setattr(watch, "before_rename", hook)
+    steps = [(1.0, _mesh()), (2.0, _mesh())]
+    with pytest.raises(watch.Terminated):
+        write_result(_result(exports={"one": _mesh(), "s": steps}), tmp_path)
+    assert asked == ["table_9_1.csv", "table_9_1_one.vtu", "table_9_1_s_0.vtu",
+                     "table_9_1_s_1.vtu", "table_9_1_s.pvd"]
+    assert sorted(p.name for p in (tmp_path / "vtu").iterdir()) == [
+        "table_9_1_one.vtu", "table_9_1_s_0.vtu", "table_9_1_s_1.vtu"]
+    assert not (tmp_path / "table_9_1.json").exists()
+
+
+def test_stale_vtu_temporaries_in_results_vtu_removed(tmp_path):
+    """A VTU or PVD temporary left in results/vtu/ by a job killed outright (kill -9)
+    is removed before the next run of its module; finished exports stay."""
+    from hpfebe.cli import remove_stale_temporaries
+
+    d = tmp_path / "vtu"
+    d.mkdir()
+    stale = [d / ".figure_9_1_final.k1ll3d.vtu", d / ".figure_9_1_steps.k1ll3d.pvd"]
+    keep = [d / "figure_9_1_final.vtu", d / ".figure_9_2_final.k1ll3d.vtu"]
+    for p in stale + keep:
+        p.write_bytes(b"x")
+    assert sorted(remove_stale_temporaries(tmp_path, ["figure_9_1"])) == sorted(stale)
+    assert all(p.exists() for p in keep) and not any(p.exists() for p in stale)

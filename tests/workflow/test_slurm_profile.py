@@ -9,7 +9,6 @@ from __future__ import annotations
 
 import dataclasses
 import re
-import sys
 from pathlib import Path
 
 import pytest
@@ -32,8 +31,7 @@ def bundles() -> dict:
 
 @pytest.fixture(scope="module")
 def rules() -> set[str]:
-    sys.path.insert(0, str(ROOT))
-    from experiments.registry import discover
+    from hpfebe.suite.registry import discover
 
     return {job.rule for job in discover(ROOT / "experiments").jobs}
 

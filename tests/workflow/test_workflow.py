@@ -3,7 +3,6 @@ registry.  No test reads or writes the working tree's results/, report/ or .snak
 the runs use a scratch directory whose experiments/, config/, src/, profiles/ and
 report/published/ are links to the checkout's."""
 
-import importlib.util
 import os
 import shutil
 import socket
@@ -17,12 +16,9 @@ ROOT = Path(__file__).resolve().parents[2]
 
 
 def _registry_module():
-    spec = importlib.util.spec_from_file_location("_hpfebe_registry",
-                                                  ROOT / "experiments" / "registry.py")
-    mod = importlib.util.module_from_spec(spec)
-    sys.modules[spec.name] = mod  # dataclasses look their module up
-    spec.loader.exec_module(mod)
-    return mod
+    from hpfebe.suite import registry
+
+    return registry
 
 
 def scratch_tree(path: Path) -> Path:
@@ -88,13 +84,12 @@ def test_job_commands_do_not_change_between_calls(tree):
     assert "HPFEBE_PARENT_PID" not in runs[0].stdout
 
 
-def test_registry_cache_written_by_the_main_snakemake(tree, monkeypatch):
+def test_registry_cache_written_by_the_main_snakemake(tree):
     """The main Snakemake writes the registry it discovered to .snakemake/hpfebe/ (the
     nested Snakemakes of cluster jobs read it instead of parsing every experiment file
     again, while no file under experiments/ changed)."""
     import pickle
 
-    monkeypatch.syspath_prepend(str(ROOT))      # the pickle names experiments.registry
 
     r = snakemake("-n", cwd=tree)
     assert r.returncode == 0, r.stdout + r.stderr
@@ -102,7 +97,7 @@ def test_registry_cache_written_by_the_main_snakemake(tree, monkeypatch):
                                  .read_bytes())
     fresh = _registry_module().discover(ROOT / "experiments")   # the Snakefile's own
     assert [j.rule for j in cached.jobs] == [j.rule for j in fresh.jobs]
-    assert str(ROOT / "experiments" / "registry.py") in stamp
+    assert str(ROOT / "src" / "hpfebe" / "suite" / "registry.py") in stamp
 
 
 def test_one_rule_per_job(tree):

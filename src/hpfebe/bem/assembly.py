@@ -16,10 +16,11 @@ time at N = 1024 and 4096 on a quiet machine, but compiling the parfor cost a 2-
 process ~9 s of a cold start; the serial steps the threads now share were 3 % of V + K + W
 at N = 4096, the sandwich's page faults 0.3 s in one task.)
 
-Caching: numba's on-disk cache keys a function on the contents of its own file only, so
-the cached ``_assemble_rows_serial`` (:mod:`.assembly_kernels`) keeps the machine code of
-the :mod:`.integration` and :mod:`.kernels` functions it was compiled with.  After changing those files, delete
-``src/hpfebe/bem/__pycache__`` (or point NUMBA_CACHE_DIR elsewhere), or the old code runs.
+Caching: numba's on-disk cache keys a function on the contents of its own file only; the
+cached ``_assemble_rows_serial`` keeps the machine code of the :mod:`.integration` and
+:mod:`.kernels` functions it was compiled with.  :mod:`hpfebe._numba_cache` therefore
+keys the whole cache directory on every kernel source: an edit of those files gets a
+fresh cache.
 """
 
 from __future__ import annotations

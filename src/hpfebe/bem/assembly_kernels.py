@@ -16,13 +16,14 @@ fast paths as ``inline="always"`` functions of their own gave the same bits but 
 2.7x the time of the Laplace V + K at N = 1024, p = 1 (0.145 -> 0.40 s CPU, one thread,
 measured 2026-12; presumably the reference counting of their ~15 array arguments per
 pair), so they stay written out, as a call of integration.far_block per pair did before
-(the comment at the fast path).  The mirror of a symmetric matrix, the element geometry
-and the sandwich W = T^T V T have kernels here too.
+(the comment at the fast path).  The mirror of a symmetric matrix, its in-place
+symmetrisation, the element geometry and the sandwich W = T^T V T have kernels here too.
 
-Caching: numba's on-disk cache keys a function on the contents of its own file only, so
-the cached ``_assemble_rows_serial`` keeps the machine code of the :mod:`.integration` and
-:mod:`.kernels` functions it was compiled with.  After changing those files, delete
-``src/hpfebe/bem/__pycache__`` (or point NUMBA_CACHE_DIR elsewhere), or the old code runs.
+Caching: numba's on-disk cache keys a function on the contents of its own file only; the
+cached ``_assemble_rows_serial`` keeps the machine code of the :mod:`.integration` and
+:mod:`.kernels` functions it was compiled with.  :mod:`hpfebe._numba_cache` therefore
+keys the whole cache directory on every kernel source: an edit of those files gets a
+fresh cache.
 """
 
 from __future__ import annotations
@@ -319,12 +320,17 @@ def _element_geometry(nodes, elements):
 
 @njit(cache=True, nogil=True)
 def _sandwich_rows(indptr, indices, data, V, out, both, rows):
-    """out[i, j] = (R V R^T)[i, j] for i in ``rows``, j >= i (R in CSR), and out[j, i] if
-    ``both``.  Threads write the upper triangle only and mirror it afterwards: a thread
-    writing out[j, i] too touched every row of out, and on a fresh matrix the first
-    chunk took all page faults, 0.3 s of a serial step at N = 4096; one thread writes
-    both (the mirror pass costs it ~15 % of W)."""
+    """out[i, j] = (R V R^T)[i, j] for i in ``rows``, j >= i (R in CSR); if ``both``
+    (``rows`` then all rows: one thread) the lower triangle too, by the tiled mirror
+    :func:`_mirror_rows` after the upper one.  Threads write the upper triangle only and
+    mirror it afterwards: a thread writing out[j, i] too touched every row of out, and
+    on a fresh matrix the first chunk took all page faults, 0.3 s of a serial step at
+    N = 4096.  One thread writing out[j, i] beside out[i, j] (column by column, a cache
+    miss per entry) took 3.9x the time of upper triangle + mirror at N = 4096, p = 1
+    (issue 27; the same bits: the mirror copies the entries)."""
     n = out.shape[0]
+    if both and rows.shape[0] != n:
+        raise ValueError("_sandwich_rows: both=True needs all rows")
     for i in rows:
         for j in range(i, n):
             acc = 0.0
@@ -335,8 +341,24 @@ def _sandwich_rows(indptr, indices, data, V, out, both, rows):
                     s += V[k, indices[b]] * data[b]
                 acc += data[a] * s
             out[i, j] = acc
-            if both:
-                out[j, i] = acc
+    if both:
+        _mirror_rows(out, np.arange((n + 63) // 64))
+
+
+@njit(cache=True)
+def _symmetrise(A):
+    """A <- (A + A^T) / 2 in place, tile by tile (64 x 64): the same floats as numpy's
+    ``0.5 * (A + A.T)`` (0.5 (a + b) = 0.5 (b + a) in IEEE arithmetic) without its two
+    n x n temporaries."""
+    n = A.shape[0]
+    bs = 64
+    for bi in range((n + bs - 1) // bs):
+        for bj in range(bi + 1):
+            for r in range(bi * bs, min(n, (bi + 1) * bs)):
+                for c in range(bj * bs, min(r + 1, (bj + 1) * bs)):
+                    v = 0.5 * (A[r, c] + A[c, r])
+                    A[r, c] = v
+                    A[c, r] = v
 
 
 @njit(cache=True)

@@ -75,6 +75,7 @@ from ..constitutive.materials import lame_constants, linear_stress
 from ..geometry import BoundaryMesh
 from ..spaces import ContinuousSpace, DiscontinuousSpace
 from .assembly import assemble, local_block, sandwich
+from .hmatrix.dispatch import Compressible
 from .kernels import (KP_C1, KP_C1_C2, KP_C1_LOG_R, KP_C2, KP_ET, KP_ET_LOG_R, KP_LAMBDA,
                       KP_LAME_SIZE, KP_MU, LAME_DL, LAME_HS, LAME_SL)
 from .laplace import P1_W_DIRECT_MAX
@@ -137,32 +138,51 @@ def _kron2(A):
     return np.kron(A, np.eye(2))
 
 
-class LameBEM(BoundaryOperators):
+class LameBEM(Compressible, BoundaryOperators):
     """Galerkin boundary element operators of 2D linear elasticity on one boundary mesh.
 
     Parameters
     ----------
-    mesh : BoundaryMesh (closed curves, outward normals)
-    E, nu : Young's modulus (> 0) and Poisson ratio (in (-1, 0.5))
-    plane : "strain" or "stress"
-    scale : length scale R of the fundamental solution (default: 2 x diameter)
-    zero_force : constrain Psi to zero total force (scale-invariant S_hat, module doc)
-    closed_form : on a mesh with all degrees 1, V, K and Vt by the closed forms of
-        :mod:`hpfebe.bem.lowest_order_lame` (one pass; W = T^T Vt T without forming T up to
-        P1_W_DIRECT_MAX elements): equal to the quadrature path to round-off; ``False``
-        forces the general quadrature path
+    mesh : BoundaryMesh
+        closed curves, outward normals
+    E, nu : float
+        Young's modulus (> 0) and Poisson ratio (in (-1, 0.5))
+    plane : {"strain", "stress"}
+        plane strain (default) or plane stress
+    scale : float, optional
+        the length scale R of the fundamental solution (default: 2 x the diameter)
+    zero_force : bool
+        constrain Psi to zero total force (scale-invariant S_hat, see the module doc;
+        default True)
+    closed_form : bool
+        on a mesh with all degrees 1, V, K and Vt by the closed forms of
+        :mod:`hpfebe.bem.lowest_order_lame` (one pass; W = T^T Vt T without forming T up
+        to P1_W_DIRECT_MAX elements): equal to the quadrature path to round-off;
+        ``False`` forces the general quadrature path (default True)
+    compression : {None, "hmatrix"}
+        None (dense matrices, default) or "hmatrix": V, K, K_adj, W, B and S_hat become
+        LinearOperators of H-matrices (ACA+, :mod:`hpfebe.bem.hmatrix`; W compressed
+        directly from the Vt kernel), Psi a preconditioned CG on the compressed V;
+        ``hmatrix_info()`` reports storage, ranks, times, achieved errors
+    tol : float
+        the relative accuracy of the compressed operators, in (0, 1) (default 1e-8)
 
+    Notes
+    -----
     Matrices (interleaved components, assembled on first use, cached): ``V`` (W_hp^2 x
     W_hp^2), ``K`` (test W_hp^2, trial V_hp^2), ``K_adj``, ``W`` (V_hp^2 x V_hp^2), ``M``,
     ``B = K + M/2``, ``S_hat``; ``Psi(U)`` the discrete traction.  Post-processing at
-    interior points: ``representation`` (Somigliana), ``displacement_gradient``, ``stress``.
+    interior points: ``representation`` (Somigliana), ``displacement_gradient``,
+    ``stress``.
     """
 
     d = 2
+    _intermediates = ("Vt",)     # only W's input: S_hat releases it (issue 27, memory)
 
     def __init__(self, mesh: BoundaryMesh, E: float, nu: float, plane: str = "strain",
                  scale: float | None = None, zero_force: bool = True,
-                 closed_form: bool = True):
+                 closed_form: bool = True, compression: str | None = None,
+                 tol: float = 1e-8):
         self.lam, self.mu = lame_constants(E, nu, plane)       # checks E, nu, plane
         self.E, self.nu, self.plane = float(E), float(nu), plane
         if isinstance(mesh, BoundaryMesh) and scale is None:
@@ -172,6 +192,11 @@ class LameBEM(BoundaryOperators):
         self.kp = _checked_kernel_params(E, nu, self.lam, self.mu, self.scale)
         # p = 1 everywhere: V, K and Vt by the closed forms, all in one pass
         self.closed_form = boolean("closed_form", closed_form) and _closed_form_applies(mesh)
+        self._set_compression(compression, tol)
+
+    def hmatrix_kernels(self):
+        """(kernel id, log coefficient) of V, K and of W's kernel Vt."""
+        return ((LAME_SL, _logc(self.c1)), (LAME_DL, NO_LOG), (LAME_HS, _logc(self.Et)))
 
     def _closed(self, key: str) -> None:
         """One pass of the closed forms fills the cache's V, K and Vt (those not there)."""
@@ -193,6 +218,8 @@ class LameBEM(BoundaryOperators):
     @property
     def V(self) -> np.ndarray:
         """Single layer (1.4), W_hp^2 x W_hp^2, symmetric positive definite."""
+        if self.hm is not None:
+            return self.hm.V
         self._closed("V")
         return self._get("V", lambda: assemble(LAME_SL, _logc(self.c1), self.kp,
                                                self.W_space, self.W_space, d=2,
@@ -201,6 +228,8 @@ class LameBEM(BoundaryOperators):
     @property
     def K(self) -> np.ndarray:
         """Double layer (1.4), test W_hp^2, trial V_hp^2."""
+        if self.hm is not None:
+            return self.hm.K
         self._closed("K")
         return self._get("K", lambda: assemble(LAME_DL, NO_LOG, self.kp,
                                                self.W_space, self.V_space, d=2))
@@ -225,7 +254,10 @@ class LameBEM(BoundaryOperators):
 
     @property
     def W(self) -> np.ndarray:
-        """Hypersingular operator, V_hp^2 x V_hp^2: <W U, U'> = <Vt dU/ds, dU'/ds>."""
+        """Hypersingular operator, V_hp^2 x V_hp^2, with
+        <W U, U'> = <Vt dU/ds, dU'/ds>."""
+        if self.hm is not None:
+            return self.hm.W
         if self.closed_form and self.mesh.n_elements <= P1_W_DIRECT_MAX:
             # p = 1, small mesh: T^T Vt T without forming T (as LaplaceBEM.W)
             return self._get("W", lambda: lame_p1_w(self.Vt, self.W_space, self.V_space))
@@ -233,7 +265,8 @@ class LameBEM(BoundaryOperators):
 
     @property
     def m(self) -> np.ndarray:
-        """(2 n_W, 2): the total-force functionals, m[:, c] . Psi = int Psi_c ds."""
+        """The total-force functionals, shape (2 n_W, 2), with
+        m[:, c] . Psi = int Psi_c ds."""
         def build():
             m1 = np.asarray(self.V_space.mass_matrix(self.W_space).sum(axis=1)).ravel()
             return np.kron(m1[:, None], np.eye(2))

@@ -49,6 +49,7 @@ from ..checks import boolean
 from ..geometry import BoundaryMesh
 from ..spaces import ContinuousSpace, DiscontinuousSpace
 from .assembly import assemble, sandwich
+from .hmatrix.dispatch import Compressible
 from .kernels import INV_2PI, KP_LAPLACE_LOG_R, LAPLACE_DL, LAPLACE_SL
 from .lowest_order import applies as _closed_form_applies
 from .lowest_order import laplace_p1_vk, laplace_p1_w
@@ -68,26 +69,45 @@ def _scale_param(R: float) -> np.ndarray:
     return kp
 
 
-class LaplaceBEM(BoundaryOperators):
+class LaplaceBEM(Compressible, BoundaryOperators):
     """Galerkin boundary element operators of the Laplacian on one boundary mesh.
 
     Parameters
     ----------
-    mesh : BoundaryMesh (closed curves, outward normals)
-    scale : length scale R of the fundamental solution (default: diameter of the mesh)
-    zero_flux : constrain Psi to zero total flux (scale-invariant S_hat, see module doc)
-    closed_form : on a mesh with all degrees 1, assemble V and K together by the closed
-        forms of :mod:`hpfebe.bem.lowest_order` (and W = T^T V T without forming T up to
+    mesh : BoundaryMesh
+        closed curves, outward normals
+    scale : float, optional
+        the length scale R of the fundamental solution (default: the diameter of the
+        mesh)
+    zero_flux : bool
+        constrain Psi to zero total flux (scale-invariant S_hat, see the module doc;
+        default True)
+    closed_form : bool
+        on a mesh with all degrees 1, assemble V and K together by the closed forms of
+        :mod:`hpfebe.bem.lowest_order` (and W = T^T V T without forming T up to
         P1_W_DIRECT_MAX elements): equal to the quadrature path to round-off, 2-5x
-        faster (issue 14); ``False`` forces the general quadrature path
+        faster (issue 14); ``False`` forces the general quadrature path (default True)
+    compression : {None, "hmatrix"}
+        None (dense matrices, default) or "hmatrix": V, K, K_adj, W, B and S_hat become
+        LinearOperators of H-matrices (ACA+, :mod:`hpfebe.bem.hmatrix`), Psi a
+        preconditioned CG on the compressed V; ``hmatrix_info()`` reports storage,
+        ranks, times and the achieved errors
+    tol : float
+        the relative accuracy of the compressed operators, in (0, 1) (checked also when
+        ``compression`` is None; default 1e-8)
 
-    Attributes: ``W_space`` (W_hp), ``V_space`` (V_hp, all dofs), and the matrices
-    ``V``, ``K``, ``W``, ``M``, ``B``, ``S_hat`` (assembled on first use, then cached);
-    ``Psi(U)``; see :class:`~hpfebe.bem.operators.BoundaryOperators`.
+    Notes
+    -----
+    ``W_space`` (W_hp) and ``V_space`` (V_hp, all dofs) are the spaces; the matrices
+    ``V``, ``K``, ``W``, ``M``, ``B``, ``S_hat`` are assembled on first use, then
+    cached; ``Psi(U)`` is the discrete flux (see
+    :class:`~hpfebe.bem.operators.BoundaryOperators`), ``representation`` the field
+    inside (1.2).
     """
 
     def __init__(self, mesh: BoundaryMesh, scale: float | None = None,
-                 zero_flux: bool = True, closed_form: bool = True):
+                 zero_flux: bool = True, closed_form: bool = True,
+                 compression: str | None = None, tol: float = 1e-8):
         if isinstance(mesh, BoundaryMesh) and scale is None:
             scale = mesh_diameter(mesh)
         super().__init__(mesh, scale, constrained=zero_flux)
@@ -95,6 +115,12 @@ class LaplaceBEM(BoundaryOperators):
         self.kp = _scale_param(self.scale)
         # p = 1 everywhere: V and K by the closed forms, both in one pass
         self.closed_form = boolean("closed_form", closed_form) and _closed_form_applies(mesh)
+        self._set_compression(compression, tol)
+
+    def hmatrix_kernels(self):
+        """(kernel id, log coefficient) of V, K and of W's single-layer kernel."""
+        return ((LAPLACE_SL, SINGLE_LAYER_LOGC), (LAPLACE_DL, NO_LOG),
+                (LAPLACE_SL, SINGLE_LAYER_LOGC))
 
     def _closed_vk(self):
         V, K = laplace_p1_vk(self.W_space, self.V_space, self.scale)
@@ -104,6 +130,8 @@ class LaplaceBEM(BoundaryOperators):
     @property
     def V(self) -> np.ndarray:
         """Single layer, W_hp x W_hp, symmetric positive definite."""
+        if self.hm is not None:
+            return self.hm.V
         if self.closed_form and "V" not in self._cache:
             self._closed_vk()
         return self._get("V", lambda: assemble(LAPLACE_SL, SINGLE_LAYER_LOGC, self.kp,
@@ -112,6 +140,8 @@ class LaplaceBEM(BoundaryOperators):
     @property
     def K(self) -> np.ndarray:
         """Double layer, test W_hp, trial V_hp."""
+        if self.hm is not None:
+            return self.hm.K
         if self.closed_form and "K" not in self._cache:
             self._closed_vk()
         return self._get("K", lambda: assemble(LAPLACE_DL, NO_LOG, [0.0],
@@ -129,7 +159,9 @@ class LaplaceBEM(BoundaryOperators):
 
     @property
     def W(self) -> np.ndarray:
-        """Hypersingular operator, V_hp x V_hp: <W U, U'> = <V dU/ds, dU'/ds>."""
+        """Hypersingular operator, V_hp x V_hp, with <W U, U'> = <V dU/ds, dU'/ds>."""
+        if self.hm is not None:
+            return self.hm.W
         if self.closed_form and self.mesh.n_elements <= P1_W_DIRECT_MAX:
             # p = 1, small mesh: T^T V T without forming T (T costs more than W there);
             # larger meshes use the sandwich, which runs on threads
@@ -139,7 +171,7 @@ class LaplaceBEM(BoundaryOperators):
 
     @property
     def m(self) -> np.ndarray:
-        """m_k = int_Gamma Phi_k ds (W_hp): the total-flux functional."""
+        """The total-flux functional, m_k = int_Gamma Phi_k ds (W_hp)."""
         return self._get("m", lambda: np.asarray(self.M.sum(axis=1)).ravel())
 
     @property

@@ -122,7 +122,7 @@ class BEBody(_LinearBody):
 
     @property
     def S(self) -> np.ndarray:
-        """The dense S_hat (assembled on first use: traces do not need it)."""
+        """The dense S_hat (assembled on first use, as traces do not need it)."""
         if self._S is None:
             self._S = self.body.S_hat
         return self._S

@@ -40,14 +40,17 @@ operator (measured, N = 4 punch).
 
 from __future__ import annotations
 
+import numba
 import numpy as np
 import scipy.linalg as sla
 import scipy.sparse as sp
 
 from ..bem.lame import LameBEM
 from ..bem.potentials import POT_LAME_DL, evaluate_potential
+from ..checks import array, instance
 from ..fem.newton_potential import CellComplex, edge_integrals, kelvin_constants, \
     newton_operators
+from ..geometry.containment import INSIDE, ON, classify_points, first_cut
 
 GAUSS_EDGE = 4
 
@@ -61,6 +64,120 @@ def _graded_rule(levels: int = 4, order: int = 8):
     gx, gw = np.polynomial.legendre.leggauss(order)
     a, b = br[:-1, None], br[1:, None]
     return (a + 0.5 * (gx + 1) * (b - a)).ravel(), (0.5 * gw * (b - a)).ravel()
+
+
+@numba.njit(cache=True)
+def _side(a0, a1, x, tol):
+    """+1 / -1 if x lies left / right of the line a0 -> a1 by more than the distance
+    ``tol``, else 0."""
+    ex, ey = a1[0] - a0[0], a1[1] - a0[1]
+    d = ex * (x[1] - a0[1]) - ey * (x[0] - a0[0])
+    t = tol * np.sqrt(ex * ex + ey * ey)
+    return 1 if d > t else (-1 if d < -t else 0)
+
+
+@numba.njit(cache=True)
+def _strictly_in(P, x, tol):
+    """Whether x lies inside the convex counter-clockwise polygon P (k, 2), farther than
+    the distance ``tol`` from the line of every edge."""
+    k = P.shape[0]
+    for j in range(k):
+        if _side(P[j], P[(j + 1) % k], x, tol) != 1:
+            return False
+    return True
+
+
+@numba.njit(cache=True)
+def _first_overlap(nodes, cells, centroids, tol):
+    """The first pair (i, j), i < j, of convex counter-clockwise cells whose interiors
+    overlap: a vertex or the centroid of one strictly inside the other, or two edges
+    crossing at a point inside both (the ends of each strictly on both sides of the
+    other's line; "strictly": farther than the distance ``tol``); (-1, -1) if there is
+    none.  Pairs with disjoint bounding boxes are skipped."""
+    nc, k = cells.shape
+    lo = np.empty((nc, 2))
+    hi = np.empty((nc, 2))
+    for i in range(nc):
+        for m in range(2):
+            lo[i, m] = nodes[cells[i, 0], m]
+            hi[i, m] = nodes[cells[i, 0], m]
+            for j in range(1, k):
+                lo[i, m] = min(lo[i, m], nodes[cells[i, j], m])
+                hi[i, m] = max(hi[i, m], nodes[cells[i, j], m])
+    for i in range(nc):
+        Pi = nodes[cells[i]]
+        for j in range(i + 1, nc):
+            if (lo[j, 0] >= hi[i, 0] or hi[j, 0] <= lo[i, 0] or lo[j, 1] >= hi[i, 1]
+                    or hi[j, 1] <= lo[i, 1]):
+                continue
+            Pj = nodes[cells[j]]
+            if _strictly_in(Pi, centroids[j], tol) or _strictly_in(Pj, centroids[i], tol):
+                return i, j
+            for v in range(k):
+                if _strictly_in(Pi, Pj[v], tol) or _strictly_in(Pj, Pi[v], tol):
+                    return i, j
+            for u in range(k):
+                a0, a1 = Pi[u], Pi[(u + 1) % k]
+                for v in range(k):
+                    b0, b1 = Pj[v], Pj[(v + 1) % k]
+                    if _side(a0, a1, b0, tol) * _side(a0, a1, b1, tol) == -1 and \
+                            _side(b0, b1, a0, tol) * _side(b0, b1, a1, tol) == -1:
+                        return i, j
+    return -1, -1
+
+
+def check_cells(mesh, cx: CellComplex) -> None:
+    """ValueError naming ``cells`` unless the cells of ``cx`` are a valid cell complex of
+    the body enclosed by the boundary mesh ``mesh``: finite nodes; every cell convex and
+    of an area above 1e-12 diam(body)^2 (not degenerate); every vertex inside the body or
+    on Gamma, every centroid inside, no boundary element cutting a cell (then every
+    cell lies in the closed body, non-convex bodies included); no two cells
+    overlapping (a vertex or centroid of one inside another, crossing edges); the cells
+    no larger than the body in total; and every cell edge on Gamma a BEM element (its
+    ends BEM nodes; the Somigliana identity used on the other edges holds inside the
+    body only).  Tolerances: 1e-9 diam(body) for distances, 1e-9 for the sine of a
+    reflex angle."""
+    diam = mesh.diameter
+    tol = 1e-9 * diam
+    nodes = array("cells.nodes", cx.nodes, shape=(None, 2))
+    P = nodes[cx.cells]                                            # (nc, k, 2), ccw
+    if np.any(cx.areas <= 1e-12 * diam ** 2):
+        c = int(np.argmin(cx.areas))
+        raise ValueError(f"cells must not be degenerate: cell {c} (vertices "
+                         f"{P[c].tolist()}) has area {cx.areas[c]:.3g}, against the "
+                         f"body's diameter {diam:.3g}")
+    E = np.roll(P, -1, axis=1) - P                                 # edge vectors
+    F = np.roll(E, -1, axis=1)                                     # the next ones
+    turn = E[..., 0] * F[..., 1] - E[..., 1] * F[..., 0]           # |e| |f| sin(angle)
+    L = np.linalg.norm(E, axis=-1) * np.linalg.norm(F, axis=-1)
+    bad = np.flatnonzero(np.any(turn < -1e-9 * L, axis=1))
+    if bad.size:
+        raise ValueError(f"cells must be convex polygons: cell {int(bad[0])} (vertices "
+                         f"{P[bad[0]].tolist()}) is not")
+    where = classify_points(mesh, nodes[np.unique(cx.cells)], tol)
+    if np.any(where < ON):
+        v = np.unique(cx.cells)[int(np.flatnonzero(where < ON)[0])]
+        raise ValueError(f"cells must lie inside the body: cell node {int(v)} at "
+                         f"{nodes[v].tolist()} is outside its boundary mesh")
+    where = classify_points(mesh, cx.centroids, tol)
+    if np.any(where != INSIDE):
+        c = int(np.flatnonzero(where != INSIDE)[0])
+        raise ValueError(f"cells must lie inside the body: the centroid of cell {c} at "
+                         f"{cx.centroids[c].tolist()} is not inside its boundary mesh")
+    c, k = first_cut(mesh, nodes, cx.cells, tol)
+    if c >= 0:
+        raise ValueError(f"cells must lie inside the body: the boundary element {k} "
+                         f"({mesh.a[k].tolist()} to {mesh.b[k].tolist()}) cuts cell {c} "
+                         f"(vertices {P[c].tolist()})")
+    i, j = _first_overlap(nodes, np.ascontiguousarray(cx.cells, dtype=np.int64),
+                          np.ascontiguousarray(cx.centroids), tol)
+    if i >= 0:
+        raise ValueError(f"cells must not overlap: cells {i} (vertices {P[i].tolist()}) "
+                         f"and {j} (vertices {P[j].tolist()}) do")
+    area = 0.5 * float(np.sum(mesh.a[:, 0] * mesh.b[:, 1] - mesh.b[:, 0] * mesh.a[:, 1]))
+    if cx.areas.sum() > area * (1 + 1e-9):
+        raise ValueError(f"cells must not overlap: their areas add up to "
+                         f"{cx.areas.sum():.6g}, more than the body's {area:.6g}")
 
 
 def match_nodes(points: np.ndarray, nodes: np.ndarray, tol: float) -> np.ndarray:
@@ -78,14 +195,13 @@ class CellStrainOperators:
     S = S_hat, :meth:`point_operators` (the displacement at interior points)."""
 
     def __init__(self, bem: LameBEM, cells: CellComplex, E: float, nu: float):
-        if not isinstance(bem, LameBEM):
-            raise ValueError(f"bem must be a LameBEM (2D elasticity), got {type(bem).__name__}")
-        if not isinstance(cells, CellComplex):
-            raise ValueError(f"cells must be a CellComplex, got {type(cells).__name__}")
+        instance("bem", bem, LameBEM, "a LameBEM (2D elasticity)")
+        instance("cells", cells, CellComplex)
         if bem.plane != "strain":
             raise ValueError(f"bem must be plane strain (J2 body), got plane={bem.plane!r}")
         if not np.all(bem.mesh.degrees == 1):
             raise ValueError("bem must have degree 1 on every element (P1 displacements)")
+        check_cells(bem.mesh, cells)
         self.bem, self.cells = bem, cells
         self.E, self.nu = E, nu
         self.ndofs = 2 * bem.V_space.ndof
@@ -132,6 +248,14 @@ class CellStrainOperators:
         if not np.any(on):
             raise ValueError("cells must share edges with the BEM boundary (no cell edge "
                              "lies on Gamma: node coordinates do not match)")
+        mid = 0.5 * (cx.nodes[cx.edges[:, 0]] + cx.nodes[cx.edges[:, 1]])
+        along = ~on & (classify_points(mesh, mid, tol) == ON)
+        if np.any(along):
+            e = int(np.flatnonzero(along)[0])
+            raise ValueError(f"cells must meet Gamma in whole BEM elements: the edge "
+                             f"{cx.nodes[cx.edges[e]].tolist()} of cell "
+                             f"{int(cx.edge_cell[e])} lies on Gamma but is no BEM element "
+                             "(its ends must be the two nodes of one element)")
         node_dof = np.full(len(mesh.nodes), -1)
         node_dof[mesh.elements[:, 0]] = bem.V_space.elem_dofs[:, 0]
         node_dof[mesh.elements[:, 1]] = bem.V_space.elem_dofs[:, 1]

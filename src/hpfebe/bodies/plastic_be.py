@@ -49,6 +49,7 @@ import scipy.linalg as sla
 import scipy.sparse as sp
 
 from ..bem.lame import LameBEM
+from ..checks import array, choice, instance, integer, tolerance
 from ..geometry import BoundaryMesh
 from ..fem.elasticity import rectangle_mesh
 from ..fem.newton_potential import CellComplex, initial_stress
@@ -94,7 +95,7 @@ def _times_blocks_kernel(A, D):
 
 
 class ElastoPlasticBE(CellStrainOperators):
-    """J2 elastoplastic BE body.  ``bem``: :class:`LameBEM` of degree 1 (plane strain),
+    """J2 elastoplastic BE body.  ``bem``: :class:`~hpfebe.bem.LameBEM` of degree 1 (plane strain),
     ``cells``: :class:`CellComplex` covering the region where plastic strain may appear
     (the whole work piece or a part of it, its nodes on Gamma coinciding with BEM nodes),
     ``material``: :class:`J2Material` with the BEM's E and nu."""
@@ -103,11 +104,8 @@ class ElastoPlasticBE(CellStrainOperators):
 
     def __init__(self, bem: LameBEM, cells: CellComplex, material: J2Material,
                  scheme: str = "explicit"):
-        if scheme not in SCHEMES:
-            raise ValueError(f"scheme must be one of {SCHEMES}, got {scheme!r}")
-        self.scheme = scheme
-        if not isinstance(material, J2Material):
-            raise ValueError(f"material must be a J2Material, got {type(material).__name__}")
+        self.scheme = choice("scheme", scheme, SCHEMES)
+        instance("material", material, J2Material)
         if isinstance(bem, LameBEM) and not (np.isclose(bem.E, material.E) and
                                              np.isclose(bem.nu, material.nu)):
             raise ValueError(f"material (E={material.E}, nu={material.nu}) must have the "
@@ -258,7 +256,7 @@ class ElastoPlasticBE(CellStrainOperators):
 
     def update(self, u: np.ndarray, eps_p: np.ndarray | None = None):
         """Return map at the cell points from the committed state with the strain of
-        (u, eps_p): the :class:`ReturnMap` (a pure function)."""
+        (u, eps_p): the :class:`~hpfebe.constitutive.j2.ReturnMap` (a pure function)."""
         return return_map(self.material, self.strain(u, eps_p), self.committed, None)
 
     def commit(self, u: np.ndarray) -> None:
@@ -357,14 +355,19 @@ class DirichletSolver:
     factorised once; the prescribed dofs must remove the rigid motions)."""
 
     def __init__(self, body: ElastoPlasticBE, fixed, values, f_ext=None):
+        instance("body", body, ElastoPlasticBE)
         n = body.ndofs
-        self.fixed = np.asarray(fixed, dtype=np.int64)
+        self.fixed = array("fixed", fixed, ndim=1, dtype=np.int64)   # 1.5 is no dof
         if self.fixed.size == 0 or self.fixed.min() < 0 or self.fixed.max() >= n:
             raise ValueError(f"fixed must be a non-empty list of dofs in [0, {n})")
-        self.values = np.broadcast_to(np.asarray(values, dtype=float), self.fixed.shape).copy()
-        self.f_ext = np.zeros(n) if f_ext is None else np.asarray(f_ext, dtype=float)
-        if self.f_ext.shape != (n,):
-            raise ValueError(f"f_ext must have shape ({n},), got {self.f_ext.shape}")
+        if np.unique(self.fixed).size != self.fixed.size:
+            raise ValueError("fixed must not contain duplicates")
+        values = array("values", values)
+        if values.shape not in ((), self.fixed.shape):
+            raise ValueError(f"values must be a scalar or one value per fixed dof "
+                             f"({self.fixed.size}), got shape {values.shape}")
+        self.values = np.broadcast_to(values, self.fixed.shape).copy()
+        self.f_ext = np.zeros(n) if f_ext is None else array("f_ext", f_ext, shape=(n,))
         self.free = np.setdiff1d(np.arange(n), self.fixed)
         S = body.S
         self.S_fc = S[np.ix_(self.free, self.fixed)]
@@ -387,9 +390,12 @@ def staggered_path(body: ElastoPlasticBE, solver: DirichletSolver, factors,
     updated once per load step; reported as not converged by the fixed point, accepted
     here).  Returns (u, list of SolverInfo); stops at the first step whose fixed point
     did not converge (with ``max_iter`` > 1)."""
-    factors = np.asarray(factors, dtype=float)
-    if factors.ndim != 1 or factors.size == 0 or np.any(np.diff(factors) <= 0):
-        raise ValueError("factors must be a non-empty increasing sequence of load factors")
+    instance("solver", solver, DirichletSolver)
+    factors = array("factors", factors, ndim=1, min_size=1)
+    if np.any(np.diff(factors) <= 0):
+        raise ValueError(f"factors must be an increasing sequence of load factors, got "
+                         f"{factors.tolist()}")
+    tol, max_iter = tolerance("tol", tol), integer("max_iter", max_iter, lo=1)
     infos, u = [], np.zeros(body.ndofs)
     for lam in factors:
         solver.lam = float(lam)
@@ -416,8 +422,7 @@ class PlasticBEBody(BEBody):
     linear = False
 
     def __init__(self, be: ElastoPlasticBE):
-        if not isinstance(be, ElastoPlasticBE):
-            raise ValueError(f"be must be an ElastoPlasticBE, got {type(be).__name__}")
+        instance("be", be, ElastoPlasticBE)
         super().__init__(be.bem, S=be.S)
         self.plastic = be
 
@@ -462,15 +467,10 @@ def rectangle_work_piece(box, nx: int, ny: int, material: J2Material,
     (``cells="crossed"``: each split into four triangles, :func:`crossed_cells`);
     ``cell_rows``: only the top ``cell_rows`` rows of cells (the region where plastic
     strain can appear; default all ny)."""
-    for name, v in (("nx", nx), ("ny", ny)):
-        if isinstance(v, bool) or int(v) != v or v < 1:
-            raise ValueError(f"{name} must be a positive integer, got {v!r}")
-    if cells not in CELL_KINDS:
-        raise ValueError(f"cells must be one of {CELL_KINDS}, got {cells!r}")
-    rows = ny if cell_rows is None else cell_rows
-    if isinstance(rows, bool) or int(rows) != rows or not 1 <= rows <= ny:
-        raise ValueError(f"cell_rows must be an integer in [1, ny={ny}], got {cell_rows!r}")
-    x0, x1, y0, y1 = (float(v) for v in box)
+    nx, ny = integer("nx", nx, lo=1), integer("ny", ny, lo=1)
+    choice("cells", cells, CELL_KINDS)
+    rows = integer("cell_rows", ny if cell_rows is None else cell_rows, lo=1, hi=ny)
+    x0, x1, y0, y1 = (float(v) for v in array("box", box, shape=(4,)))
     if not (x1 > x0 and y1 > y0):
         raise ValueError(f"box must be (x0, x1, y0, y1) with x1 > x0, y1 > y0, got {box!r}")
     mesh = BoundaryMesh.polygon([(x0, y0), (x1, y0), (x1, y1), (x0, y1)],

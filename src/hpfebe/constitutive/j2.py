@@ -32,7 +32,9 @@ Plane strain: the strain has eps_33 = 0, but the stress, the plastic strain and 
 stress are full 3 x 3 tensors (the out-of-plane plastic strain eps_p_33 is not zero).
 
 All functions work on N points at once: tensors (N, 3, 3), scalars (N,); no loops over
-points.
+points.  :func:`radial_return_point` is the same radial return at one point for numba
+kernels (tensors as 9-vectors, row-major), which the FE body's element loop calls
+(:mod:`hpfebe.fem.plastic_body`); it gives the numbers of :func:`return_map` to round-off.
 """
 
 from __future__ import annotations
@@ -40,6 +42,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+import numba
 import numpy as np
 
 from ..checks import array, choice, integer, real
@@ -109,7 +112,7 @@ class J2Material:
 
     @property
     def stress_floor(self) -> float:
-        """min(sigma_Y, 1e-3 E): the stress scale of the absolute floors of stopping
+        """min(sigma_Y, 1e-3 E), the stress scale of the absolute floors of stopping
         tests (a yield-level stress; capped at the stress of a 0.1 % strain, so that a
         material that does not yield in the small-strain range - sigma_Y = 4e12, an
         elastic check - does not get a floor above every force of the problem, which
@@ -226,3 +229,43 @@ def consistent_tangent(mat: J2Material, rm: ReturnMap, tangent: str = "algorithm
     return (kappa * ONE_ONE[None] + 2.0 * mu * theta1[:, None, None, None, None] * P_DEV[None]
             - 2.0 * mu * theta_bar[:, None, None, None, None]
             * np.einsum("nij,nkl->nijkl", n, n))
+
+
+@numba.njit(cache=True)
+def radial_return_point(eps, ep, alpha, beta, mu, kappa, H, theta, sigma_Y,
+                        sigma, ep_new, beta_new, normal):
+    """The radial return (4.38)-(4.41) at one point (tensors as 9-vectors, row-major):
+    from the committed (``ep``, ``alpha``, ``beta``) to the total strain ``eps``; writes
+    the stress ``sigma``, the updated ``ep_new``, ``beta_new`` and the flow direction
+    ``normal`` n = eta_trial / ||eta_trial||; returns (alpha_new, dgamma, f_trial,
+    ||eta_trial|| or 1 where it is 0) - the numbers of :func:`return_map` at the point."""
+    tr = eps[0] + eps[4] + eps[8]
+    nrm2 = 0.0
+    for a in range(9):
+        d = eps[a] - tr / 3.0 if a % 4 == 0 else eps[a]
+        s = 2.0 * mu * (d - ep[a])
+        sigma[a] = s                          # s_trial until the update below
+        normal[a] = s - beta[a]               # eta_trial
+        nrm2 += normal[a] * normal[a]
+    norm = math.sqrt(nrm2)
+    f = norm - SQ23 * (sigma_Y + theta * H * alpha)
+    dg = f / (2.0 * mu + 2.0 / 3.0 * H) if f > 0.0 else 0.0
+    safe = norm if norm > 0.0 else 1.0
+    hk = (2.0 / 3.0) * (1.0 - theta) * H
+    for a in range(9):
+        n = normal[a] / safe
+        normal[a] = n
+        ep_new[a] = ep[a] + dg * n
+        beta_new[a] = beta[a] + hk * dg * n
+        sigma[a] = (kappa * tr if a % 4 == 0 else 0.0) + sigma[a] - 2.0 * mu * dg * n
+    return alpha + SQ23 * dg, dg, f, safe
+
+
+@numba.njit(cache=True)
+def tangent_factors(dgamma, safe, plastic, mu, H, algorithmic):
+    """(theta_1, theta_bar) of the tangent at one point (module doc): C = kappa 1 x 1 +
+    2 mu theta_1 (I - 1/3 1 x 1) - 2 mu theta_bar n x n; (1, 0) at an elastic point."""
+    if not plastic:
+        return 1.0, 0.0
+    theta1 = 1.0 - 2.0 * mu * dgamma / safe if algorithmic else 1.0
+    return theta1, 1.0 / (1.0 + H / (3.0 * mu)) - (1.0 - theta1)

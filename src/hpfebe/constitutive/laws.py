@@ -64,22 +64,8 @@ class LawState:
 
     @property
     def key(self) -> bytes:
-        """The contact pattern (state and direction of slip): for cycling detection."""
+        """The contact pattern (state and direction of slip), for cycling detection."""
         return self.state.tobytes() + np.signbit(self.trial).tobytes()
-
-
-def positive(name: str, value, allow_zero: bool = False) -> float:
-    """A finite real > 0 (>= 0 with ``allow_zero``); ValueError naming ``name``."""
-    if isinstance(value, (bool, str, bytes)):
-        raise ValueError(f"{name} must be a real number, got {value!r}")
-    try:
-        v = float(value)
-    except (TypeError, ValueError):
-        raise ValueError(f"{name} must be a real number, got {value!r}") from None
-    if not (np.isfinite(v) and (v >= 0 if allow_zero else v > 0)):
-        what = "non-negative" if allow_zero else "positive"
-        raise ValueError(f"{name} must be finite and {what}, got {value!r}")
-    return v
 
 
 def normal_penalty(penetration, eps_n: float, active=None):

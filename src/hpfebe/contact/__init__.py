@@ -6,7 +6,7 @@ and mortar contact of two BE bodies (:class:`MortarContact`, Section 4.3) or of 
 (:class:`FEMortarContact`, Section 4.4).  The bodies: :mod:`hpfebe.bodies`; the pointwise
 laws: :mod:`hpfebe.constitutive`; Newton and the load path: :mod:`hpfebe.solvers`."""
 
-from .friction import FrictionResult, solve_friction
+from .friction import FrictionResult, FrictionSettings, solve_friction
 from .loading import LoadSteps
 from .limits import (MACHEPS, PenaltyCheck, backward_error, check_penalty_solution,
                      constrained_limit, saturation_index, singular_exponent,
@@ -27,3 +27,4 @@ __all__ = ["ContactResult", "FEMortarContact", "FrictionResult",
            "singular_exponent", "solve_penalty_checked"]
 __all__ += ["NeumannSettings"]
 __all__ += ["node_points"]
+__all__ += ["FrictionSettings"]

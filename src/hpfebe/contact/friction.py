@@ -30,10 +30,11 @@ semismooth iteration then crawls through the stick band of width eps_t s.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 
 from ..bodies.body import RigidObstacle, against_obstacle
-from ..constitutive.laws import OPEN, SLIP, STATE_NAMES, STICK  # noqa: F401  (re-exported)
 from ..checks import InputTypeError, boolean, choice, integer, real
 from .result import ContactResult
 from .settings import ContactSettings
@@ -41,6 +42,64 @@ from .two_body import TwoBodyContact
 
 LAWS = ("tresca", "coulomb")
 FrictionResult = ContactResult
+
+
+@dataclass(frozen=True)
+class FrictionSettings:
+    """The law and the solver settings of :func:`solve_friction` (validated on creation).
+
+    Attributes
+    ----------
+    eps_n, eps_t : float
+        Penalty parameters (> 0) of the normal and the tangential law.
+    friction : {"tresca", "coulomb"}
+        Tresca (give the bound ``F`` >= 0, float or callable F(x)) or Coulomb (give the
+        coefficient ``mu_f`` >= 0).
+    F, mu_f : float or callable, float
+        The Tresca bound or the Coulomb coefficient (the other one stays None).
+    load_steps : int
+        N equal increments of the load and the obstacle motion (the slip history is
+        carried from step to step).
+    max_iter, tol : int, float
+        Newton limit and relative tolerance per load step (module doc).
+    nq : int or None
+        Gauss points per contact element (None: p_I + 1).
+    predictor : bool
+        Start each step from the bonded predictor when it lowers the merit.
+    contact_label, dirichlet_label : str
+        The labels of Gamma_C and Gamma_D on the mesh.
+    """
+
+    eps_n: float
+    eps_t: float
+    friction: str = "tresca"
+    F: object = None
+    mu_f: float | None = None
+    load_steps: int = 1
+    max_iter: int = 50
+    tol: float = 1e-10
+    nq: int | None = None
+    predictor: bool = True
+    contact_label: str = "C"
+    dirichlet_label: str = "D"
+
+    def __post_init__(self):
+        checked = dict(eps_n=real("eps_n", self.eps_n, positive=True),
+                       eps_t=real("eps_t", self.eps_t, positive=True))
+        law, bound = _law(self.friction, self.F, self.mu_f)
+        checked.update(friction=law,
+                       max_iter=integer("max_iter", self.max_iter, lo=1),
+                       load_steps=integer("load_steps", self.load_steps, lo=1),
+                       tol=real("tol", self.tol, positive=True),
+                       nq=integer("nq", self.nq, lo=1, allow_none=True),
+                       predictor=boolean("predictor", self.predictor), **bound)
+        for name, value in checked.items():
+            object.__setattr__(self, name, value)
+
+    @property
+    def bound(self) -> dict:
+        """The friction bound as :class:`TwoBodyContact` takes it (F= or mu_f=)."""
+        return dict(F=self.F) if self.friction == "tresca" else dict(mu_f=self.mu_f)
 
 
 def _law(friction, F, mu_f):
@@ -60,39 +119,42 @@ def _law(friction, F, mu_f):
     return law, dict(mu_f=real("mu_f", mu_f, nonnegative=True))
 
 
-def solve_friction(bem, eps_n: float, eps_t: float, gap, friction: str = "tresca",
-                   F=None, mu_f=None, obstacle_slip=None, load=None, load_steps: int = 1,
-                   contact_label: str = "C", dirichlet_label: str = "D",
-                   max_iter: int = 50, tol: float = 1e-10, S=None,
-                   nq: int | None = None, initial=None,
-                   predictor: bool = True) -> ContactResult:
-    """Frictional penalty contact of a :class:`LameBEM` body with a rigid obstacle.
+def solve_friction(bem, gap, settings: FrictionSettings, obstacle_slip=None, load=None,
+                   S=None, initial=None) -> ContactResult:
+    """Frictional penalty contact of a :class:`~hpfebe.bem.LameBEM` body with a rigid obstacle.
 
-    bem : LameBEM (its mesh carries the labels); eps_n, eps_t : penalty parameters (> 0)
-    gap : float or callable g(x) on Gamma_C (constraint U_n <= g)
-    friction : "tresca" (give F >= 0, float or callable) or "coulomb" (give mu_f >= 0)
-    obstacle_slip : tangential motion w of the obstacle (float or callable), reached at
-        the last load step; load : interleaved vector L(v) on V_hp^2, likewise
-    load_steps : N equal increments; the slip history is carried from step to step
-    max_iter, tol : Newton limit and relative tolerance per step (module doc)
-    S : S_hat to reuse (default ``bem.S_hat``); nq : Gauss points per contact element
-    predictor : start each step from the bonded predictor when it lowers the merit
-    initial : a converged result of the same body, law and points to continue from
-        (U, slip, load and obstacle motion ramped from its final values)
+    Parameters
+    ----------
+    bem : LameBEM
+        The body (its mesh carries the labels of ``settings``).
+    gap : float or callable
+        g(x) on Gamma_C (constraint U_n <= g).
+    settings : FrictionSettings
+        The law (penalty parameters, Tresca or Coulomb) and the Newton settings.
+    obstacle_slip : float or callable, optional
+        Tangential motion w of the obstacle, reached at the last load step.
+    load : ndarray, optional
+        Interleaved vector L(v) on V_hp^2, likewise ramped.
+    S : ndarray, optional
+        S_hat to reuse (default ``bem.S_hat``).
+    initial : ContactResult, optional
+        A converged result of the same body, law and points to continue from (U, slip,
+        load and obstacle motion ramped from its final values).
+
+    Returns
+    -------
+    ContactResult
+        U, the contact state at the Gauss points, the Newton history per load step.
     """
-    eps_n = real("eps_n", eps_n, positive=True)
-    eps_t = real("eps_t", eps_t, positive=True)
-    law, bound = _law(friction, F, mu_f)
-    max_iter = integer("max_iter", max_iter, lo=1)
-    load_steps = integer("load_steps", load_steps, lo=1)
-    tol = real("tol", tol, positive=True)
-    nq = integer("nq", nq, lo=1, allow_none=True)
-    predictor = boolean("predictor", predictor)
-    body, fixed, f = against_obstacle(bem, S, contact_label, dirichlet_label, load)
-    pr = TwoBodyContact(body, RigidObstacle(gap, obstacle_slip), contact_label,
-                        eps_n=eps_n, eps_t=eps_t, nq=nq, **bound)
-    return pr.solve(f, fixed, None, np.arange(1, load_steps + 1) / load_steps,
-                    ContactSettings(rtol=tol, max_iter=max_iter, line_search=True,
-                                    norm="max", predictor=predictor,
-                                    merit="energy" if law == "tresca" else "residual"),
+    if not isinstance(settings, FrictionSettings):
+        raise InputTypeError(f"settings must be a FrictionSettings, got {settings!r}")
+    st = settings
+    body, fixed, f = against_obstacle(bem, S, st.contact_label, st.dirichlet_label, load)
+    pr = TwoBodyContact(body, RigidObstacle(gap, obstacle_slip), st.contact_label,
+                        eps_n=st.eps_n, eps_t=st.eps_t, nq=st.nq, **st.bound)
+    return pr.solve(f, fixed, None, np.arange(1, st.load_steps + 1) / st.load_steps,
+                    ContactSettings(rtol=st.tol, max_iter=st.max_iter, line_search=True,
+                                    norm="max", predictor=st.predictor,
+                                    merit="energy" if st.friction == "tresca"
+                                    else "residual"),
                     initial=initial)

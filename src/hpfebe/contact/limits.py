@@ -143,16 +143,26 @@ def backward_error(A: np.ndarray, U: np.ndarray, G: np.ndarray) -> float:
 class PenaltyCheck:
     """Whether a penalty solution can be trusted.
 
-    condition_number : 2-norm condition number of the Newton matrix at U (free dofs)
-    residual : the solver's final max-norm residual
-    relative_residual : residual / max|(S_hat U)_free| (the physical force scale)
-    backward_error : :func:`backward_error` of G(U) = 0 on the free dofs
-    accepted : converged, finite, and relative_residual <= accept_rel or
-        backward_error <= accept_eta macheps
-    reason : the solver's reason, plus LAPACK's ill-conditioning warning and why the run
-        is not accepted
-    lapack_warning : LAPACK warned (rcond < macheps) during the solve
-    solve_s : wall time of the solve alone
+    Parameters
+    ----------
+    condition_number : float
+        2-norm condition number of the Newton matrix at U (free dofs)
+    residual : float
+        the solver's final max-norm residual
+    relative_residual : float
+        residual / max|(S_hat U)_free| (the physical force scale)
+    backward_error : float
+        :func:`backward_error` of G(U) = 0 on the free dofs
+    accepted : bool
+        converged, finite, and relative_residual <= accept_rel or backward_error <=
+        accept_eta macheps
+    reason : str
+        the solver's reason, plus LAPACK's ill-conditioning warning and why the run is
+        not accepted
+    lapack_warning : bool
+        LAPACK warned (rcond < macheps) during the solve
+    solve_s : float
+        wall time of the solve alone
     """
 
     condition_number: float

@@ -18,6 +18,7 @@ import scipy.sparse.linalg as spla
 from ..checks import array
 from ..solvers import Iterate, SingularStep, SolverInfo
 from ..constitutive.laws import STATE_NAMES, updated_slip
+from .newton_matrix import FixedPatternLU, NewtonMatrix
 from .settings import ContactSettings
 
 
@@ -64,9 +65,16 @@ class LoadSteps:
         if initial is not None:
             self._continue_from(initial)
         self.f, self.w = self.f0, self.w0
-        # cycling of the contact state is detected along a line search
-        self.detect_cycling = settings.line_search
+        # cycling of the contact state is detected with and without a line search (a
+        # full-step Newton that cycles reports "cycling", not "max_iter")
+        self.detect_cycling = True
         self._lu = {}      # factorisations of Newton matrices seen (:meth:`_factor`)
+        # a plastic (nonlinear) sparse body: the Newton matrices on one fixed pattern
+        # (:meth:`_solve_fixed`; the LU cache never hits for them)
+        self.fixed_pattern = linear_solver == "lu" and not pr.dense and \
+            pr.exact is None and not all(getattr(b, "linear", False)
+                                         for b in pr.bodies.values())
+        self._newton = None
 
     def newton_options(self) -> dict:
         """The keywords of :func:`hpfebe.solvers.newton` for these steps: the
@@ -222,7 +230,44 @@ class LoadSteps:
             law, w = it.data["law"], it.data["weights"]
             return self._solve_woodbury(it.data, w * law.dp_n, w * law.dt_t,
                                         w * law.dt_n, -it.residual)
+        if self.fixed_pattern:
+            law, w = it.data["law"], it.data["weights"]
+            return self._solve_fixed(it.data, w * law.dp_n, w * law.dt_t, w * law.dt_n,
+                                     -it.residual)
         return self._solve(self.pr.tangent(it.data), -it.residual)
+
+    def _solve_fixed(self, cs, wn, wt, wtn, r: np.ndarray) -> np.ndarray:
+        """The Newton system K_body + C on the free dofs assembled on the fixed pattern
+        of :class:`~hpfebe.contact.newton_matrix.NewtonMatrix` and factorised by
+        :class:`~hpfebe.contact.newton_matrix.FixedPatternLU` (PARDISO's symbolic
+        analysis once per load steps if pypardiso is installed, else SuperLU with the
+        ``lu_ordering``), with the residual check of :meth:`_solve`."""
+        K = cs["K_body"]
+        for attempt in (0, 1):
+            if self._newton is None:
+                opts = {} if self.lu_ordering == "COLAMD" else dict(
+                    permc_spec=self.lu_ordering, diag_pivot_thresh=0.01,
+                    options=dict(SymmetricMode=True))
+                self._newton = (NewtonMatrix(K, cs["Gn"], cs["Gt"], self.free),
+                                FixedPatternLU(opts))
+            nm, flu = self._newton
+            try:
+                A = nm.assemble(K, wn, wt, wtn)
+                break
+            except ValueError:           # K left the pattern: a new one
+                if attempt:
+                    raise
+                self._newton = None
+        try:
+            d = flu.factor(A).solve(r)
+        except RuntimeError:
+            d = np.full(r.size, np.nan)
+        if not np.all(np.isfinite(d)) or \
+                np.linalg.norm(A @ d - r) > 1e-6 * np.linalg.norm(r):
+            raise SingularStep("singular Newton matrix (body not fixed?)")
+        dx = np.zeros(self.pr.ndofs)
+        dx[self.free] = d
+        return dx
 
     def _solve_woodbury(self, cs, wn, wt, wtn, r: np.ndarray) -> np.ndarray:
         """The Newton system K + C on the free dofs by :class:`WoodburySolver` (K
@@ -256,6 +301,13 @@ class LoadSteps:
                 return it.x + self._solve_woodbury(cs, w * ones / pr.eps_n,
                                                    w * ones / pr.eps_t, 0.0 * w,
                                                    -Rb[self.free])
+            except SingularStep:
+                return None
+        if self.fixed_pattern:
+            try:
+                return it.x + self._solve_fixed(cs, w * ones / pr.eps_n,
+                                                w * ones / pr.eps_t, 0.0 * w,
+                                                -Rb[self.free])
             except SingularStep:
                 return None
         C = Gn.T @ sp.diags(w * ones / pr.eps_n) @ Gn \

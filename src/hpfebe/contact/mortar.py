@@ -40,7 +40,7 @@ import numpy as np
 
 from ..bem.lame import LameBEM
 from ..bodies.condensed import CondensedBody
-from ..checks import InputTypeError, array, instance, real
+from ..checks import InputTypeError, array, callable_returning, choice, instance, real
 from ..coupling.mortar import MortarProjection
 from ..geometry import BoundaryMesh
 from ..quadrature import gauss_lobatto
@@ -109,14 +109,29 @@ def lobatto_weights(mesh, space, dofs, label):
     return w[dofs]
 
 
+def two_bodies(a, b, names: str) -> None:
+    """ValueError naming ``names`` if ``a`` and ``b`` are one object (a body in contact
+    with itself: both copies would overlap in the reference configuration)."""
+    if a is b:
+        raise ValueError(f"{names} must be two bodies, got the same body twice")
+
+
+def dirichlet_datum(dirichlet, name: str):
+    """(label, (Ux, Uy) as a float array) of a Dirichlet datum (label, (Ux, Uy)): two
+    finite real numbers (no strings, no NaN); ValueError naming ``name``."""
+    try:
+        label, value = dirichlet
+        return label, array(name, value, shape=(2,))
+    except (TypeError, ValueError) as err:     # InputTypeError is both
+        kind = InputTypeError if isinstance(err, TypeError) else ValueError
+        raise kind(f"{name} must be (label, (Ux, Uy)) with finite real Ux, Uy, got "
+                   f"{dirichlet!r}") from None
+
+
 def condensed_body(bem, dirichlet, contact, name: str) -> CondensedBody:
     """S_hat of ``bem`` with the Dirichlet datum ``dirichlet`` = (label, (Ux, Uy))
     condensed onto the interleaved ``contact`` dofs (``name``: for the error message)."""
-    try:
-        label, value = dirichlet
-        value = np.asarray(value, dtype=float).reshape(2)
-    except (TypeError, ValueError):
-        raise ValueError(f"{name} must be (label, (Ux, Uy)), got {dirichlet!r}") from None
+    label, value = dirichlet_datum(dirichlet, name)
     if not np.any(bem.mesh.labels == label):
         raise ValueError(f"{name}: no element labelled {label!r}")
     d = bem.V_space.dofs_on(label)
@@ -272,6 +287,7 @@ class MortarContact:
                  gap=None):
         instance("bem1", bem1, LameBEM, "a LameBEM (a Lame body)")
         instance("bem2", bem2, LameBEM, "a LameBEM (a Lame body)")
+        two_bodies(bem1, bem2, "bem1, bem2")
         self.bem1, self.bem2, self.F = bem1, bem2, real("F", F, nonnegative=True)
         self.mortar = MortarProjection(bem1.mesh, bem2.mesh, label, label, axis,
                                        bem1.V_space, bem2.V_space, test_space)
@@ -284,12 +300,12 @@ class MortarContact:
             raise ValueError("dirichlet1: the contact nodes of body 1 must not be Dirichlet "
                              "nodes")
         nc = m.dofs1.size
-        self.nc = nc
-        self.points = node_points(bem1, m.dofs1)
+        self.nc, self.points = nc, node_points(bem1, m.dofs1)
         nrm = contact_normals(normal, default_normals(bem1.V_space, m.dofs1, label),
                               self.points)
         self._normal_fn = normal
-        self._gap_fn = gap
+        self._gap_fn = None if gap is None else callable_returning(   # one per point
+            "gap", gap, None, lambda x: (len(x),), allow_inf=True)
         self._set_frame(nrm)
         self.gap = self.gap_at(self.points, self.n)
         self.w = lobatto_weights(bem1.mesh, bem1.V_space, m.dofs1, label)
@@ -314,10 +330,7 @@ class MortarContact:
         along ``normals`` to Gamma^2_C (+inf where the ray misses it)."""
         if self._gap_fn is None:
             return ray_gap(x, normals, self.bem2.mesh, "C")
-        g = np.asarray(self._gap_fn(np.asarray(x, dtype=float)), dtype=float)
-        if g.shape != (len(x),) or np.any(np.isnan(g)):
-            raise ValueError(f"gap must return {len(x)} finite values, got shape {g.shape}")
-        return g
+        return self._gap_fn(np.asarray(x, dtype=float))
 
     def _normal(self, x) -> np.ndarray:
         """Unit normal of body 1 at points x of Gamma^1_C (the scene's, or the element's)."""
@@ -368,7 +381,11 @@ class MortarContact:
     def frame(self, v) -> tuple[np.ndarray, np.ndarray]:
         """Normal and tangential components at the contact nodes of an interleaved
         vector on the contact dofs of body 1."""
-        v = np.asarray(v).reshape(self.nc, 2)
+        try:
+            v = np.asarray(v, dtype=float).reshape(self.nc, 2)
+        except (TypeError, ValueError):
+            raise ValueError(f"v must be {2 * self.nc} numbers (interleaved on the contact "
+                             f"dofs of body 1), got {np.shape(v)}") from None
         n, t = self.n, self.t        # (two terms: the same sums as np.sum(v * n, axis=1))
         return v[:, 0] * n[:, 0] + v[:, 1] * n[:, 1], v[:, 0] * t[:, 0] + v[:, 1] * t[:, 1]
 
@@ -421,8 +438,7 @@ class MortarContact:
             self._rho_bound(uz.rho, uz.relative, bound)
         F = self.F if bound is None else np.asarray(bound, dtype=float)
         _, Qt = self.frame(Q)
-        lam0 = np.zeros(self.nc) if lam0 is None else array("lam0", lam0, shape=(self.nc,),
-                                                               finite=False)
+        lam0 = np.zeros(self.nc) if lam0 is None else array("lam0", lam0, shape=(self.nc,))
         Fw, upper = self._qp_data(Q, bound)
         x, lam, info = tresca_uzawa(self._bound_qp(), Fw, rho * F, Qt, upper, lam0, x0, uz)
         if not info.converged and info.reason.startswith("diverged") and bound is None:
@@ -443,8 +459,8 @@ class MortarContact:
         ``friction``: "tresca" - the bound F of j (given friction, (4.55)); "coulomb" -
         the nodal bound F p_n with p_n = max(0, -R1_n / w) of the previous DtN iteration
         (0 in the first one; the per-iteration hook :meth:`_coulomb_bound`)."""
-        if friction not in ("tresca", "coulomb"):
-            raise ValueError(f"friction must be 'tresca' or 'coulomb', got {friction!r}")
+        instance("settings", settings, DtNSettings)
+        choice("friction", friction, ("tresca", "coulomb"))
         hook = self._coulomb_bound if friction == "coulomb" else None
         P, info, st = dtn(self, settings, hook)
         load2, _ = transfer_maps(self.mortar, settings.transfer)
@@ -494,6 +510,7 @@ class MortarContact:
         the discrete problem DtN solves.  Step: rho * rho_crit / 2 if
         ``settings.relative`` (rho_crit = 2 / lambda_max of the linear response, Theorem
         3.1.8)."""
+        instance("settings", settings, GlobalUzawaSettings)
         g = self._global_operators()
         step = settings.rho * 0.5 * g["rho_crit"] if settings.relative else \
             float(settings.rho)
@@ -517,6 +534,7 @@ class MortarContact:
         (:meth:`_global_operators`); in the node frames y = (P_n, P_t) the method solves
         the complementarity functions of the normal contact and the friction law with
         c = rho_crit / 2."""
+        instance("settings", settings, SemismoothSettings)
         g = self._global_operators()
         nc, R = self.nc, self.R
         c = 0.5 * g["rho_crit"]

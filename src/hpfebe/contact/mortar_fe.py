@@ -47,14 +47,14 @@ import scipy.sparse.linalg as spla
 from scipy.linalg import lapack
 
 from ..bodies.condensed import CondensedBody
-from ..checks import instance, integer, real
+from ..checks import instance, integer, real, tolerance
 from ..constitutive.j2 import dev, tensor_norm
 from ..coupling.mortar import SIDES, MortarProjection, fe_trace_mesh
 from ..fem.elasticity import ElasticBody
 from ..fem.plastic_body import DisplacementSteps, ElastoPlasticFE
 from ..solvers import Iterate, SingularStep, SolverInfo, newton
 from ..solvers.dtn import DtNSettings, DtNState, dtn, transfer_maps
-from .mortar import MortarContact, MortarSolution, ray_gap
+from .mortar import MortarContact, MortarSolution, dirichlet_datum, ray_gap, two_bodies
 
 def _vector_dofs(body, vertex) -> np.ndarray:
     """Interleaved FE dofs (x, y of each vertex in turn) of the vertices ``vertex``."""
@@ -62,11 +62,7 @@ def _vector_dofs(body, vertex) -> np.ndarray:
 
 
 def _dirichlet(body, spec, name):
-    try:
-        label, value = spec
-        value = np.asarray(value, dtype=float).reshape(2)
-    except (TypeError, ValueError):
-        raise ValueError(f"{name} must be (label, (ux, uy)), got {spec!r}") from None
+    label, value = dirichlet_datum(spec, name)
     if label not in SIDES:
         raise ValueError(f"{name}: label must be one of {SIDES}, got {label!r}")
     fixed = body.dofs_on(label)
@@ -176,7 +172,7 @@ class NeumannSettings:
     max_iter: int = 30
 
     def __post_init__(self):
-        object.__setattr__(self, "tol", real("newton tol", self.tol, positive=True))
+        object.__setattr__(self, "tol", tolerance("newton tol", self.tol))
         object.__setattr__(self, "max_iter", integer("newton max_iter", self.max_iter,
                                                      lo=1))
 
@@ -199,6 +195,7 @@ class FEMortarContact(MortarContact):
                  F: float, contact1: str = "bottom", contact2: str = "top"):
         instance("stamp", stamp, ElasticBody)
         instance("work", work, ElastoPlasticFE)
+        two_bodies(stamp, work.elastic, "stamp, work (its elastic body)")
         self.stamp, self.work, self.F = stamp, work, real("F", F, nonnegative=True)
         self.mesh1, space1, vert1 = fe_trace_mesh(stamp.mesh, contact1)
         self.mesh2, space2, vert2 = fe_trace_mesh(work.mesh, contact2)
@@ -433,7 +430,7 @@ class FEMortarContact(MortarContact):
         1/2 |F|^2) on the KKT system :class:`MonolithicKKT`.  c: the complementarity
         constant (default the mean diagonal of A1).  Stop: ||F||_inf <= tol x (force
         scale + min(force_floor, the data's force scale ``kkt.data_scale``))."""
-        tol, max_iter = real("tol", tol, positive=True), integer("max_iter", max_iter, lo=1)
+        tol, max_iter = tolerance("tol", tol), integer("max_iter", max_iter, lo=1)
         st2 = self.steps2
         st2.f_ext = np.zeros(self.work.ndofs)
         st2.problem(1.0)

@@ -43,16 +43,26 @@ from .two_body import TwoBodyContact
 class PenaltyResult:
     """Solution of the penalty contact problem and the Newton diagnostics.
 
-    U : interleaved V_hp^2 coefficients (all dofs, zero on Gamma_D)
-    iterations : Newton steps taken; residuals : max-norm of the residual per iterate
-    converged, reason : outcome ("converged", "no contact", "max_iter", "cycling",
-        "line search failed")
-    pressure : callable (elem, t) -> p_eps = (1/eps)(U_n - g_h)_+ >= 0 on contact
-        elements (t in [-1, 1]); pressure_nodes : (x, p) at the GLL nodes of Gamma_C
-    info : the SolverInfo of the Newton iteration
-    jacobian : only with ``solve_penalty(..., keep_jacobian=True)``: the Newton matrix
+    Parameters
+    ----------
+    U : ndarray
+        interleaved V_hp^2 coefficients (all dofs, zero on Gamma_D)
+    iterations, residuals : int, list
+        the Newton steps taken and the max-norm of the residual per iterate
+    converged, reason : bool, str
+        the outcome ("converged", "no contact", "max_iter", "cycling", "line search
+        failed")
+    pressure : callable
+        (elem, t) -> p_eps = (1/eps)(U_n - g_h)_+ >= 0 on contact elements (t in
+        [-1, 1])
+    pressure_nodes : tuple
+        (x, p) at the GLL nodes of Gamma_C
+    info : SolverInfo
+        of the Newton iteration
+    jacobian : ndarray or None
+        only with ``solve_penalty(..., keep_jacobian=True)``: the Newton matrix
         S_hat + (1/eps) J_c(U) at the returned iterate, restricted to the free dofs
-        (dense; e.g. for its condition number), else None
+        (dense; e.g. for its condition number)
     """
 
     U: np.ndarray
@@ -78,15 +88,21 @@ def solve_penalty(bem, eps: float, gap, load=None, contact_label: str = "C",
 
     Parameters
     ----------
-    bem : LameBEM of the body (its mesh carries the labels)
+    bem
+        LameBEM of the body (its mesh carries the labels)
     eps : penalty parameter > 0
-    gap : float or callable g(x) (x of shape (n, 2)) on Gamma_C, constraint U_n <= g
-    load : interleaved vector L(v) on V_hp^2, default 0
-    S : S_hat to use (default ``bem.S_hat``; pass it to reuse one matrix for many eps)
-    max_iter, tol : Newton limit; stop when max|residual| <= tol * (force scale of the
+    gap
+        float or callable g(x) (x of shape (n, 2)) on Gamma_C, constraint U_n <= g
+    load
+        interleaved vector L(v) on V_hp^2, default 0
+    S
+        S_hat to use (default ``bem.S_hat``; pass it to reuse one matrix for many eps)
+    max_iter, tol
+        Newton limit; stop when max|residual| <= tol * (force scale of the
         current iterate: max of |L|, |S_hat U| and the contact forces, free dofs; not
         relative to the initial residual, which grows like 1/eps)
-    keep_jacobian : return the Newton matrix at the final iterate (free dofs)
+    keep_jacobian
+        return the Newton matrix at the final iterate (free dofs)
 
     A gap that is never closed gives the zero-contact solution (reason "no contact").
     """

@@ -13,22 +13,39 @@ from ..solvers import SolverInfo
 
 @dataclass
 class ContactResult:
-    """Outcome of :meth:`TwoBodyContact.solve` (and of :func:`solve_friction`).
+    """Outcome of :meth:`~hpfebe.contact.TwoBodyContact.solve` (and of
+    :func:`~hpfebe.contact.solve_friction`).
 
-    U : the global dof vector (slave dofs first); u_slave, u_master : its two parts
-    converged, reason : overall outcome (the reason names the failed load step)
-    info : SolverInfo of the load path; ``steps`` its SolverInfo per attempted load step
+    Parameters
+    ----------
+    U, u_slave, u_master : ndarray
+        the global dof vector (slave dofs first) and its two parts
+    converged, reason : bool, str
+        the overall outcome (the reason names the failed load step)
+    info : SolverInfo
+        of the load path; ``steps`` is its SolverInfo per attempted load step
         (load_factor, iterations, residuals, converged, reason, state_counts)
-    Contact state at the slave contact points (last iterate): points (n, 2), weights
-    (quadrature weights, 0 for points outside the master), g_n (signed gap, < 0 is
-    penetration), g_t (relative tangential displacement), p_n >= 0, t_t, bound (slip
-    bound s), state (OPEN / STICK / SLIP), slip (g_t^p after the last converged step)
-    load_vector, obstacle_motion : load and obstacle motion w of the last step (to
-    continue loading with ``initial=``)
-    passes : the pass of each contact point (0: slave points on the master; 1, with
-    ``two_pass``: master points on the slave, whose ``elements`` are master facets);
-    ``weights * (passes == 0)`` integrates over the slave side only.  With two passes
-    ``total_forces`` sums both (the physical total force)
+    points, weights : ndarray
+        the slave contact points (n, 2) and their quadrature weights (0 for points
+        outside the master); the contact state below is at these points, last iterate
+    g_n, g_t : ndarray
+        the signed gap (< 0 is penetration) and the relative tangential displacement
+    p_n, t_t, bound : ndarray
+        the contact pressure (>= 0), the tangential traction and the slip bound s
+    state, slip : ndarray
+        OPEN / STICK / SLIP, and g_t^p after the last converged step
+    elements : ndarray, optional
+        the slave element (BE) or facet (FE) of each point
+    load_vector, obstacle_motion : ndarray, optional
+        the load and the obstacle motion w of the last step (to continue loading with
+        ``initial=``)
+    friction : str
+        "coulomb" or "tresca"
+    passes : ndarray, optional
+        the pass of each contact point (0: slave points on the master; 1, with
+        ``two_pass``: master points on the slave, whose ``elements`` are master
+        facets); ``weights * (passes == 0)`` integrates over the slave side only.  With
+        two passes ``total_forces`` sums both (the physical total force)
     """
 
     U: np.ndarray
@@ -80,7 +97,7 @@ class ContactResult:
 
     @property
     def gap_function(self) -> np.ndarray:
-        """U_n - g = -g_n (> 0: penetration)."""
+        """The penetration function U_n - g = -g_n (positive where the bodies overlap)."""
         return -self.g_n
 
     @property

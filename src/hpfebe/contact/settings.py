@@ -10,7 +10,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..checks import boolean, choice, integer, real
+from ..checks import boolean, choice, integer, real, tolerance
 from ..solvers import LineSearch
 
 #: merit functions of the line search: ||R||_2, or the potential of a potential law
@@ -34,7 +34,15 @@ class ContactSettings:
     Newton stops when ||R_free|| <= atol + rtol * scale, ``norm`` "l2" or "max", scale =
     the largest of the load, the body force and the contact force of the iterate
     (max-norm over the free dofs; not relative to R^(0), which grows like 1/eps and
-    would accept wrong contact sets for stiff penalties); at most ``max_iter``
+    would accept wrong contact sets for stiff penalties): the backward-error rule of
+    :mod:`hpfebe.solvers.info`, scale-free with the default ``atol = 0`` (moduli, loads
+    and prescribed displacements scaled together give the same iterations and
+    decisions).  ``atol`` (a force) is a floor for residuals at round-off of the data
+    forces (a stamp lifted off: :func:`hpfebe.scenes.stamping.reference_force` sets it
+    to rtol x a force of the scene); it must scale with the problem, and
+    :meth:`TwoBodyContact.solve` refuses an ``atol`` above rtol x the data force
+    (:func:`hpfebe.contact.two_body.data_force`, the residual of the prescribed data), which
+    would accept the start or any iterate within that floor as converged; at most ``max_iter``
     iterations per load step; a failed step is halved and retried from the last
     converged state at most ``max_cuts`` times.  ``roundoff_stop``: a Newton update at
     round-off level ends the step, converged only if the backward error is small
@@ -71,10 +79,10 @@ class ContactSettings:
         def put(name, value):
             object.__setattr__(self, name, value)
 
-        for name in ("rtol", "atol"):
-            put(name, real(name, getattr(self, name), nonnegative=True))
-        if self.rtol == 0 and self.atol == 0:
-            raise ValueError("rtol and atol must not both be zero")
+        # 0 < rtol < 1: a purely absolute test (rtol = 0, atol > 0) is not scale-free,
+        # and rtol >= 1 accepts a residual as large as every force of the iterate
+        put("rtol", tolerance("rtol", self.rtol))
+        put("atol", real("atol", self.atol, nonnegative=True))
         put("max_iter", integer("max_iter", self.max_iter, lo=1))
         put("max_cuts", integer("max_cuts", self.max_cuts, lo=0))
         put("min_step", real("min_step", self.min_step, lo=0.0, hi=1.0, lo_open=True))
@@ -84,6 +92,24 @@ class ContactSettings:
             choice(name, getattr(self, name), allowed)
         for name in ("line_search", "predictor", "roundoff_stop"):
             put(name, boolean(name, getattr(self, name)))
+
+    def check_floor(self, data_force: float, lam: float = 1.0) -> None:
+        """ValueError unless ``atol`` is at most rtol x ``data_force`` (the residual of
+        the prescribed data at the load factor ``lam``,
+        :func:`hpfebe.contact.two_body.data_force`): above it the stopping test
+        ||R|| <= atol + rtol scale accepts residuals beyond rtol relative to every force
+        of the problem (the start itself once atol >= ||R(U_D)||), and "converged"
+        means nothing.  Scale-free: the decision is the same when atol and the problem's
+        forces are scaled together."""
+        cap = self.rtol * real("data_force", data_force, nonnegative=True)
+        if not self.atol <= cap:
+            raise ValueError(
+                f"atol must be at most rtol x the data force of this problem "
+                f"({self.rtol:g} x {data_force:.3e} = {cap:.3e}, the residual of the "
+                f"prescribed data at load factor {lam:g}), got {self.atol!r}: a larger "
+                "absolute floor accepts residuals beyond rtol relative to every force of "
+                "the problem; use atol = 0 (the scale-free default) or a floor that "
+                "scales with the problem's forces")
 
     def line_search_rule(self) -> LineSearch:
         """The Armijo rule of :func:`hpfebe.solvers.newton` for ``merit``: on the energy

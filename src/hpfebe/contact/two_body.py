@@ -125,6 +125,20 @@ from .settings import ContactSettings
 QUADRATURES = ("gauss", "exact")
 
 
+def data_force(steps: LoadSteps, lam: float = 1.0) -> float:
+    """The reference force of the data of the load ``steps`` at the load factor ``lam``:
+    ||R(U_D)|| in the norm of the stopping test, the residual on the free dofs of the
+    state U_D that is zero but for the prescribed values (the load, the forces of the
+    prescribed displacement and of an initial penetration on the undeformed bodies: the
+    start of a one-step solve).  It scales with the forces when moduli, loads and
+    prescribed displacements are scaled together."""
+    steps.problem(lam)
+    r = steps.evaluate(steps.start(np.zeros(steps.pr.ndofs), lam)).residual
+    if r.size == 0:
+        return 0.0
+    return float(np.abs(r).max() if steps.settings.norm == "max" else np.linalg.norm(r))
+
+
 def _csr_block_diag(A: sp.csr_matrix, B: sp.csr_matrix) -> sp.csr_matrix:
     """blockdiag(A, B) in CSR: the rows of A, then those of B with shifted columns (the
     entries of ``sp.block_diag``, without its COO round trip; entries in the order of
@@ -154,6 +168,13 @@ class _State(dict):
         return value
 
 
+def _objects(body) -> set:
+    """The ids of a body and of the objects its contact wrapper holds (the FE body, the
+    BEM, the plastic body): the same body given twice shares one of them."""
+    return {id(b) for b in (body, getattr(body, "body", None), getattr(body, "bem", None),
+                            getattr(body, "plastic", None)) if b is not None}
+
+
 def _force_lazy(body, u):
     """(f_int, tangent or a callable returning it) of a contact body: the callable when
     the body can defer its tangent (``internal_force_lazy``, a plastic body)."""
@@ -167,34 +188,47 @@ class TwoBodyContact:
 
     Parameters
     ----------
-    slave, master : ElasticBody (FE), LameBEM (BE), or a body of
-        :mod:`hpfebe.bodies.body` (:class:`RigidObstacle` for the master: one body
-        against a rigid obstacle, Sections 3.2-3.3)
-    slave_boundary, master_boundary : labels (str or list) of Gamma_C^s, Gamma_C^m
+    slave, master
+        ElasticBody (FE), LameBEM (BE), or a body of :mod:`hpfebe.bodies.body`
+        (:class:`~hpfebe.bodies.RigidObstacle` for the master: one body against a rigid
+        obstacle, Sections 3.2-3.3)
+    slave_boundary, master_boundary
+        labels (str or list) of Gamma_C^s, Gamma_C^m
         (FE: facet labels; BE: element labels; ignored for a rigid master)
-    eps_n, eps_t : penalty parameters (> 0); 1/eps are the contact stiffnesses
-    mu_f : Coulomb coefficient (>= 0; 0 = frictionless), or F : Tresca bound (float or
+    eps_n, eps_t
+        penalty parameters (> 0, keywords; eps_n is required, eps_t defaults
+        to 1); 1/eps are the contact stiffnesses
+    mu_f
+        Coulomb coefficient (>= 0; 0 = frictionless), or F : Tresca bound (float or
         callable of the points, >= 0; acts on all of Gamma_C)
-    nq : Gauss points per integration piece (two bodies: at least p_max + 1 with a BE
+    nq
+        Gauss points per integration piece (two bodies: at least p_max + 1 with a BE
         body; rigid master: per element, default p_I + 1 for a BE slave, 2 for FE)
-    split : split the slave segments at the projections of the master vertices
-    quadrature : "gauss" (fixed points above) or "exact": a BE body against a rigid
+    split
+        split the slave segments at the projections of the master vertices
+    quadrature
+        "gauss" (fixed points above) or "exact": a BE body against a rigid
         obstacle without friction, (U_n - g_h)_+ integrated exactly on the pieces where
         it is positive (:mod:`hpfebe.contact.positive_part`, Section 3.2)
-    two_pass : False (default) = one master-slave pass, the thesis's Section 4.2
+    two_pass
+        False (default) = one master-slave pass, the thesis's Section 4.2
         formulation; True = the symmetric two-pass treatment (module doc: a second pass
         with the bodies' roles swapped, contact stiffness about 2/eps_n on a flat
         interface); two deformable bodies and quadrature "gauss" only
     """
 
-    def __init__(self, slave, master, slave_boundary, master_boundary=None,
-                 eps_n: float = None, eps_t: float = 1.0, mu_f: float = 0.0, F=None,
+    def __init__(self, slave, master, slave_boundary, master_boundary=None, *,
+                 eps_n: float, eps_t: float = 1.0, mu_f: float = 0.0, F=None,
                  nq: Optional[int] = 2, split: bool = True, quadrature: str = "gauss",
                  two_pass: bool = False):
         self.bodies = {"slave": as_body(slave, "slave"), "master": as_body(master, "master")}
         self.slave, self.master = slave, master
         if self.bodies["slave"].kind == "rigid":
             raise ValueError("slave must be a deformable body (the obstacle is the master)")
+        if _objects(slave) & _objects(master):
+            raise ValueError("slave, master must be two bodies, got the same body twice "
+                             "(self-contact is not modelled: its two copies would "
+                             "overlap in the reference configuration)")
         self.eps_n = real("eps_n", eps_n, positive=True)
         self.eps_t = real("eps_t", eps_t, positive=True)
         self.mu_f = real("mu_f", mu_f, nonnegative=True)
@@ -245,7 +279,7 @@ class TwoBodyContact:
 
     @property
     def K(self):
-        """The stiffness of the bodies (4.27)/(4.33) at rest: dense without FE body."""
+        """The stiffness of the bodies (4.27)/(4.33) at rest (dense without FE body)."""
         sb, mb = self.bodies["slave"], self.bodies["master"]
         if self.dense:
             return sla.block_diag(*[b.S for b in (sb, mb) if b.kind == "BE"])
@@ -427,6 +461,9 @@ class TwoBodyContact:
         instance("settings", settings, ContactSettings)
         steps = LoadSteps(self, f_ext, fixed_dofs, fixed_values, settings, initial)
         lf = array("load_factors", load_factors, ndim=1, min_size=1)
+        if settings.atol > 0:                 # an absolute floor: scaled with the data?
+            lam = float(lf[np.argmax(np.abs(lf))])
+            settings.check_floor(data_force(steps, lam), lam)
         it, info = load_path(steps, lf, steps.x0, max_cuts=settings.max_cuts, lam0=0.0,
                              **steps.newton_options())
         return self.result(it, info, steps)

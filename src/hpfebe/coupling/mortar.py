@@ -115,10 +115,14 @@ class MortarProjection:
 
     Parameters
     ----------
-    mesh1, mesh2 : BoundaryMesh of body 1 (mortar side) and body 2
-    label1, label2 : contact labels of the two meshes
-    axis : unit vector; the parameter s = x . axis pairs the points of the two zones
-    space1, space2 : the ContinuousSpace of each mesh (default: built on the mesh)
+    mesh1, mesh2
+        BoundaryMesh of body 1 (mortar side) and body 2
+    label1, label2
+        contact labels of the two meshes
+    axis
+        unit vector; the parameter s = x . axis pairs the points of the two zones
+    space1, space2
+        the ContinuousSpace of each mesh (default: built on the mesh)
 
     Attributes: ``dofs1``, ``dofs2`` (scalar contact dofs), ``D`` (n1 x n1), ``B``
     (n1 x n2), ``M2`` (n2 x n2, mass matrix of X^2_hp), sparse; ``overlap`` =

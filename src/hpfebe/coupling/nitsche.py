@@ -135,12 +135,17 @@ class NitscheFEBE:
 
     Parameters
     ----------
-    problem : InterfaceProblem (geometry, exact solution, data)
-    fe_h_inv, be_h_inv : inverse mesh sizes of the FE mesh of Omega1 and the BE mesh of
+    problem
+        InterfaceProblem (geometry, exact solution, data)
+    fe_h_inv, be_h_inv
+        inverse mesh sizes of the FE mesh of Omega1 and the BE mesh of
         dOmega2 (non-matching on Gamma_I in general)
-    p_fe, p_be : polynomial degrees p1 (FE) and p2 (BE; default p1)
-    alpha : exponent of p1 in the penalty term (2.4)
-    h_def : "diameter" (h_K = diam K, Section 2.1) or "edge" (edge length on Gamma_I)
+    p_fe, p_be
+        polynomial degrees p1 (FE) and p2 (BE; default p1)
+    alpha
+        exponent of p1 in the penalty term (2.4)
+    h_def
+        "diameter" (h_K = diam K, Section 2.1) or "edge" (edge length on Gamma_I)
     """
 
     def __init__(self, problem: InterfaceProblem, fe_h_inv: float, be_h_inv: float,
@@ -262,7 +267,24 @@ class NitscheFEBE:
         return value
 
     def solve(self, lambda_nit: float = DEFAULT_LAMBDA) -> NitscheSolution:
-        """Solve (2.3) by one sparse LU of the coupled system (module doc)."""
+        """Solve (2.3) by one sparse LU of the coupled system (module doc).
+
+        Parameters
+        ----------
+        lambda_nit : float
+            the Nitsche parameter lambda_Nit (default :data:`DEFAULT_LAMBDA` = 10)
+
+        Returns
+        -------
+        NitscheSolution
+            U1 (FE, all dofs), U2 (BE, all V_hp dofs), ``info`` (residual, timings,
+            sizes) and ``solver`` (the SolverInfo of the direct solve).
+
+        Raises
+        ------
+        numpy.linalg.LinAlgError
+            if the coupled system is singular or its relative residual exceeds 1e-6.
+        """
         t0 = time.perf_counter()
         lambda_nit = self._check_lambda(lambda_nit)
         K11, K12, K22 = blocks = self.blocks(lambda_nit)

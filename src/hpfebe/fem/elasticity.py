@@ -32,6 +32,7 @@ from skfem import (
 )
 from skfem.models.elasticity import linear_elasticity
 
+from ..checks import choice, integer, real
 from ..constitutive.materials import lame_constants
 from .meshes import FEDomain
 
@@ -43,11 +44,9 @@ def rectangle_mesh(
 ):
     """Uniform mesh of [x0, x1] x [y0, y1] with nx x ny cells (``kind="tri"``: each cell
     split into two triangles), boundary facets labelled "left", "right", "bottom", "top"."""
-    if kind not in KINDS:
-        raise ValueError(f"kind must be one of {KINDS}, got {kind!r}")
-    for name, n in (("nx", nx), ("ny", ny)):
-        if int(n) != n or n < 1:
-            raise ValueError(f"{name} must be a positive integer, got {n!r}")
+    choice("kind", kind, KINDS)
+    nx, ny = integer("nx", nx, lo=1), integer("ny", ny, lo=1)
+    x0, x1, y0, y1 = (real(k, v) for k, v in zip(("x0", "x1", "y0", "y1"), (x0, x1, y0, y1)))
     if not (x1 > x0):
         raise ValueError(f"x1 must exceed x0, got x0={x0!r}, x1={x1!r}")
     if not (y1 > y0):
@@ -97,7 +96,7 @@ class ElasticBody:
 
     @property
     def nodal_dofs(self) -> np.ndarray:
-        """(2, n_vertices) dof indices: row c = component c."""
+        """(2, n_vertices) dof indices, row c = component c."""
         return self.basis.nodal_dofs
 
     def boundary_labels(self) -> list:

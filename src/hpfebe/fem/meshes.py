@@ -47,6 +47,8 @@ from typing import Callable, Sequence
 import numpy as np
 from skfem import MeshQuad
 
+from ..checks import array, choice, real
+
 
 def block_grid(breaks: Sequence[float], h_inv: float, rounding: str = "floor") -> np.ndarray:
     """1D grid of cells of size about 1/h_inv through all ``breaks``.
@@ -56,19 +58,21 @@ def block_grid(breaks: Sequence[float], h_inv: float, rounding: str = "floor") -
     divided equally: the total count is that of the uniform grid, a break that falls
     between grid lines takes the lower one.  ``rounding="ceil"``: every block of length L
     gets ceil(L h_inv) cells (no cell larger than 1/h_inv)."""
-    b = np.unique(np.asarray(breaks, dtype=float))
+    b = np.unique(array("breaks", breaks, ndim=1))          # finite numbers
     if b.size < 2:
         raise ValueError(f"breaks must contain at least two distinct values, got {breaks!r}")
-    if not (np.isfinite(h_inv) and h_inv > 0):
-        raise ValueError(f"h_inv must be positive, got {h_inv!r}")
+    h_inv = real("h_inv", h_inv, positive=True)
+    choice("rounding", rounding, ("floor", "ceil"))
     if rounding == "floor":
         k = np.floor((b - b[0]) * h_inv + 1e-9)
         k[-1] = np.ceil((b[-1] - b[0]) * h_inv - 1e-9)
-        counts = np.maximum(np.diff(k), 1).astype(int)
-    elif rounding == "ceil":
-        counts = np.maximum(np.ceil(np.diff(b) * h_inv - 1e-9), 1).astype(int)
+        counts = np.maximum(np.diff(k), 1)
     else:
-        raise ValueError(f"rounding must be 'floor' or 'ceil', got {rounding!r}")
+        counts = np.maximum(np.ceil(np.diff(b) * h_inv - 1e-9), 1)
+    if counts.sum() > 10 ** 7:            # h_inv = 1e20 asked numpy for 1e20 cells
+        raise ValueError(f"h_inv must give at most 1e7 cells along an axis, got "
+                         f"h_inv={h_inv!r}: {float(counts.sum()):.3g} cells")
+    counts = counts.astype(int)
     pts = [b[:1]]
     for lo, hi, n in zip(b[:-1], b[1:], counts):
         pts.append(np.linspace(lo, hi, n + 1)[1:])
@@ -122,7 +126,8 @@ def tensor_block_mesh(xbreaks, ybreaks, h_inv: float,
     """Conforming rectangle mesh of the subdomain ``inside(x, y)`` (see module doc).
 
     ``label(x, y)`` returns one label string per boundary facet midpoint."""
-    xs, ys = block_grid(xbreaks, h_inv, rounding), block_grid(ybreaks, h_inv, rounding)
+    xs = block_grid(array("xbreaks", xbreaks, ndim=1), h_inv, rounding)
+    ys = block_grid(array("ybreaks", ybreaks, ndim=1), h_inv, rounding)
     nx, ny = len(xs) - 1, len(ys) - 1
     I, J = np.meshgrid(np.arange(nx), np.arange(ny), indexing="ij")
     I, J = I.ravel(), J.ravel()

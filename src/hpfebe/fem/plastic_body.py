@@ -1,7 +1,17 @@
 """An elastoplastic FE body (J2 flow theory, :mod:`hpfebe.constitutive.j2`) for Chapter 4's
 work piece (Sections 4.2.2-4.2.3, 4.2.6): P1 triangles or Q1 quadrilaterals (scikit-fem),
 history (eps_p, alpha, beta) at the quadrature points, internal force and algorithmic
-tangent assembled vectorised (numpy matmul/einsum over elements and points).
+tangent assembled by numba kernels over the elements (one pass: strain, radial return,
+stress and element force; one pass: tangent element matrices written straight into the
+fixed CSR pattern of the stiffness K), without (nel, nq, 9, 9) temporaries.
+
+The element matrices need no 9 x 9 tangent: with B_i the (symmetric) strain of local
+basis function i at a point, tr_i = tr B_i, G_ij = dev B_i : dev B_j and m_i = n : B_i,
+
+    B_i : C_alg : B_j = kappa tr_i tr_j + 2 mu theta_1 G_ij - 2 mu theta_bar m_i m_j
+
+(the tangent of :mod:`hpfebe.constitutive.j2`; theta_1 = 1, theta_bar = 0 at an elastic
+point, the elastic element matrix).
 
     f_int(u)_i = sum_K sum_q w_q B_i(x_q) : sigma(eps(u)(x_q); committed history)
     T(u)_ij    = sum_K sum_q w_q B_i(x_q) : C_alg(x_q) : B_j(x_q)                   (4.36)-(4.37)
@@ -21,7 +31,7 @@ The body protocol of the contact problems (:mod:`hpfebe.bodies.body`):
 ``internal_force(u) -> (f_int, tangent)`` is a pure function of u and the *committed*
 history (trial return map), ``commit(u)`` makes the state at u the committed history (call
 it only after a load step converged); a failed, cut load step therefore restarts from the
-committed state automatically.  :class:`PlasticFEBody` wraps the body as a contact
+committed state automatically.  :class:`~hpfebe.bodies.PlasticFEBody` wraps the body as a contact
 :class:`~hpfebe.bodies.body.FEBody` (kind "FE", segments, traces, dofs ...).
 
 :class:`DisplacementSteps` is the :class:`hpfebe.solvers.LoadStep` of a body alone under
@@ -41,8 +51,8 @@ from ..checks import array, boolean, choice, finite, instance
 from ..solvers import Iterate, SingularStep
 from .elasticity import ElasticBody
 from .meshes import FEDomain
-from ..constitutive.j2 import (J2Material, J2State, consistent_tangent, dev, return_map,
-                         tensor_norm, TANGENTS)
+from ..constitutive.j2 import (J2Material, J2State, ReturnMap, dev, radial_return_point,
+                               tangent_factors, tensor_norm, TANGENTS)
 
 FORMULATIONS = ("bbar", "full")
 
@@ -83,6 +93,90 @@ def _force_kernel(B, s, dx):
     return out
 
 
+@numba.njit(cache=True)
+def _state_kernel(B, ue, dx, ep, alpha, beta, mu, kappa, H, theta, sigma_Y):
+    """Strain eps = B ue, the radial return from the committed (ep, alpha, beta) (all
+    (nel * nq, ...)), the stress and the element forces fe[e, i] = sum_q sum_a
+    B[e, q, i, a] sigma[e, q, a] dx[e, q] in one pass over the elements."""
+    ne, nq, nl, na = B.shape
+    n = ne * nq
+    sigma, ep_new, beta_new = np.empty((n, 9)), np.empty((n, 9)), np.empty((n, 9))
+    normal = np.empty((n, 9))
+    alpha_new, dgamma, f_trial, safe = np.empty(n), np.empty(n), np.empty(n), np.empty(n)
+    fe = np.zeros((ne, nl))
+    eps = np.empty(9)
+    for e in range(ne):
+        for q in range(nq):
+            p = e * nq + q
+            for a in range(na):
+                acc = 0.0
+                for i in range(nl):
+                    acc += B[e, q, i, a] * ue[e, i]
+                eps[a] = acc
+            alpha_new[p], dgamma[p], f_trial[p], safe[p] = radial_return_point(
+                eps, ep[p], alpha[p], beta[p], mu, kappa, H, theta, sigma_Y,
+                sigma[p], ep_new[p], beta_new[p], normal[p])
+            for i in range(nl):
+                acc = 0.0
+                for a in range(na):
+                    acc += B[e, q, i, a] * sigma[p, a] * dx[e, q]
+                fe[e, i] += acc
+    return sigma, ep_new, alpha_new, beta_new, normal, dgamma, f_trial, safe, fe
+
+
+@numba.njit(cache=True)
+def _elastic_kernel(TR, G, dx, kappa, mu):
+    """Elastic element matrices sum_q dx (kappa tr_i tr_j + 2 mu G_ij) (nel, nl, nl)."""
+    ne, nq, nl = TR.shape
+    Ke = np.zeros((ne, nl, nl))
+    for e in range(ne):
+        for q in range(nq):
+            for i in range(nl):
+                for j in range(nl):
+                    Ke[e, i, j] += dx[e, q] * (kappa * TR[e, q, i] * TR[e, q, j]
+                                               + 2.0 * mu * G[e, q, i, j])
+    return Ke
+
+
+@numba.njit(cache=True)
+def _tangent_kernel(B, TR, G, dx, Ke_el, pos, nnz, normal, dgamma, safe, plastic,
+                    kappa, mu, H, algorithmic):
+    """The CSR data (nnz,) of the tangent on the pattern of K (``pos[e, i, j]``: the
+    position of element entry (i, j) in it): the element matrix (module doc) of every
+    element with a plastic point, the elastic one ``Ke_el`` elsewhere."""
+    ne, nq, nl, na = B.shape
+    data = np.zeros(nnz)
+    Ke = np.empty((nl, nl))
+    m = np.empty(nl)
+    for e in range(ne):
+        any_plastic = False
+        for q in range(nq):
+            any_plastic = any_plastic or plastic[e * nq + q]
+        if not any_plastic:
+            for i in range(nl):
+                for j in range(nl):
+                    data[pos[e, i, j]] += Ke_el[e, i, j]
+            continue
+        Ke[:, :] = 0.0
+        for q in range(nq):
+            p = e * nq + q
+            t1, tb = tangent_factors(dgamma[p], safe[p], plastic[p], mu, H, algorithmic)
+            for i in range(nl):
+                acc = 0.0
+                for a in range(na):
+                    acc += normal[p, a] * B[e, q, i, a]
+                m[i] = acc
+            for i in range(nl):
+                for j in range(nl):
+                    Ke[i, j] += dx[e, q] * (kappa * TR[e, q, i] * TR[e, q, j]
+                                            + 2.0 * mu * t1 * G[e, q, i, j]
+                                            - 2.0 * mu * tb * m[i] * m[j])
+        for i in range(nl):
+            for j in range(nl):
+                data[pos[e, i, j]] += Ke[i, j]
+    return data
+
+
 class ElastoPlasticFE:
     """J2 elastoplastic P1/Q1 body.  ``mesh`` (labelled skfem MeshTri/MeshQuad or
     FEDomain), ``material`` (:class:`J2Material`), ``formulation`` ("bbar" or "full"),
@@ -116,11 +210,21 @@ class ElastoPlasticFE:
         self._cols = np.tile(dofs.T, (1, nloc)).ravel()
         self.committed = J2State.zeros(self.nel * self.nq)
         self.sigma = np.zeros((self.nel * self.nq, 3, 3))          # committed stress
+        # the geometry of the element matrices (module doc): tr B_i, dev B_i : dev B_j
+        B3 = self.B.reshape(self.B.shape[:3] + (3, 3))
+        self._TR = np.ascontiguousarray(np.trace(B3, axis1=-2, axis2=-1))
+        devB = dev(B3).reshape(self.B.shape)
+        self._G = np.ascontiguousarray(np.einsum("eqia,eqja->eqij", devB, devB))
         # element matrices of the elastic tangent: the tangent of an element whose
-        # points are all elastic (the same numbers as assembling it there, bit for bit)
-        self._Ke_el = self._element_matrices(np.ascontiguousarray(np.broadcast_to(
-            material.elastic_tangent().reshape(9, 9), (self.nel, self.nq, 9, 9))))
+        # points are all elastic (the numbers of :func:`_tangent_kernel` there)
+        self._Ke_el = _elastic_kernel(self._TR, self._G, self._dx_c, material.kappa,
+                                      material.mu)
         self.K = self._coo(self._Ke_el)
+        # position of element entry (e, i, j) in K.data: the tangent's fixed pattern
+        lookup = sp.csr_matrix((np.arange(1, self.K.nnz + 1, dtype=float),
+                                self.K.indices, self.K.indptr), shape=self.K.shape)
+        self._pos = (np.asarray(lookup[self._rows, self._cols]).ravel().astype(np.int64)
+                     - 1).reshape(self.nel, nloc, nloc)
         self._cache = None
 
     # ------------------------------------------------------------------ kinematics
@@ -131,6 +235,17 @@ class ElastoPlasticFE:
     @property
     def n_points(self) -> int:
         return self.nel * self.nq
+
+    def dofs_on(self, labels, component: int | None = None) -> np.ndarray:
+        """Dofs of the vertices on the boundary part(s) ``labels`` (a label or a list of
+        the mesh's ``boundaries``); ``component`` 0 / 1 for one component, None for both.
+        The numbering of :class:`~hpfebe.fem.elasticity.ElasticBody` on the same mesh
+        (the same vector P1/Q1 basis)."""
+        return self.elastic.dofs_on(labels, component)
+
+    def dof_coordinates(self) -> np.ndarray:
+        """(ndofs, 2) coordinates of the vertex of every dof."""
+        return self.elastic.dof_coordinates()
 
     def _strain_operator(self) -> np.ndarray:
         """(nel, nq, nloc, 3, 3) -> reshaped (nel, nq, nloc, 9): the (B-bar) strain of each
@@ -172,19 +287,23 @@ class ElastoPlasticFE:
 
     def tangent_matrix(self, rm, tangent: str | None = None) -> sp.csr_matrix:
         """The tangent (4.36)-(4.37) of the return map ``rm`` (:meth:`state_at`):
-        assembled from the consistent tangent at the points of the elements with a
-        plastic point only, the elastic element matrices elsewhere (the numbers of the
-        full assembly, bit for bit; the elastic stiffness K itself if no point is
-        plastic)."""
-        tg = self.tangent if tangent is None else tangent
-        pe = np.flatnonzero(rm.plastic.reshape(self.nel, self.nq).any(axis=1))
-        if pe.size == 0:
+        element matrices (module doc) of the elements with a plastic point, the elastic
+        ones elsewhere, written by :func:`_tangent_kernel` into the pattern of K (the
+        full assembly of :func:`~hpfebe.constitutive.j2.consistent_tangent` to round-off;
+        the elastic stiffness K itself if no point is plastic).  The pattern is fixed:
+        the Newton solver of the contact problems analyses it once
+        (:mod:`hpfebe.contact.newton_matrix`)."""
+        tg = choice("tangent", self.tangent if tangent is None else tangent, TANGENTS)
+        if not rm.plastic.any():
             return self.K
-        pts = (pe[:, None] * self.nq + np.arange(self.nq)).ravel()
-        C = consistent_tangent(self.material, rm, tg, pts).reshape(pe.size, self.nq, 9, 9)
-        Ke = self._Ke_el.copy()
-        Ke[pe] = self._element_matrices(C, pe)
-        return self._coo(Ke)
+        m = self.material
+        data = _tangent_kernel(self.B, self._TR, self._G, self._dx_c, self._Ke_el,
+                               self._pos, self.K.nnz,
+                               np.ascontiguousarray(rm.normal.reshape(-1, 9)), rm.dgamma,
+                               rm.eta_norm, rm.plastic, m.kappa, m.mu, m.H,
+                               tg == "algorithmic")
+        # the pattern of K (its index arrays shared): a fixed pattern for the solver
+        return sp.csr_matrix((data, self.K.indices, self.K.indptr), shape=self.K.shape)
 
     def _force(self, sigma: np.ndarray) -> np.ndarray:
         s = np.ascontiguousarray(sigma.reshape(self.nel, self.nq, 9))
@@ -200,10 +319,24 @@ class ElastoPlasticFE:
         key = np.asarray(u, dtype=float)
         if self._cache is not None and np.array_equal(self._cache[0], key):
             return self._cache[1], self._cache[2]
-        rm = return_map(self.material, self.strain(key), self.committed, None)
-        f = self._force(rm.sigma)
+        rm, fe = self._return_map(array("u", key, shape=(self.ndofs,), finite=False))
+        f = np.bincount(self.element_dofs.T.ravel(), fe.ravel(), minlength=self.ndofs)
         self._cache = (key.copy(), f, rm, {})
         return f, rm
+
+    def _return_map(self, u: np.ndarray):
+        """(:class:`~hpfebe.constitutive.j2.ReturnMap` at u from the committed history,
+        element forces (nel, nloc)) by :func:`_state_kernel`."""
+        m, c, n = self.material, self.committed, self.n_points
+        ue = np.ascontiguousarray(u[self.element_dofs].T)
+        sigma, ep, alpha, beta, normal, dgamma, f_trial, safe, fe = _state_kernel(
+            self.B, ue, self._dx_c, np.ascontiguousarray(c.eps_p.reshape(n, 9)),
+            np.ascontiguousarray(c.alpha), np.ascontiguousarray(c.beta.reshape(n, 9)),
+            m.mu, m.kappa, m.H, m.theta, m.sigma_Y)
+        t = (n, 3, 3)
+        rm = ReturnMap(sigma.reshape(t), J2State(ep.reshape(t), alpha, beta.reshape(t)),
+                       None, dgamma, f_trial > 0.0, f_trial, normal.reshape(t), safe)
+        return rm, fe
 
     def response(self, u: np.ndarray, tangent: str | None = None):
         """The return map at u from the committed history: (f_int, tangent matrix,

@@ -2,7 +2,8 @@
 
 The mesh class and its conventions (labels, degrees, orientation): :mod:`.mesh`;
 input checks: :mod:`.validation`; the orientation of the curves: :mod:`.orientation`;
-the self-intersection test (a grid of segments): :mod:`.crossing`; bisection and
+the self-intersection test (a grid of segments): :mod:`.crossing`; points and convex
+polygons inside, on or outside the enclosed region: :mod:`.containment`; bisection and
 degrees: :mod:`.refinement`; the common refinement of several meshes: :mod:`.common`.
 """
 

@@ -33,11 +33,15 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..checks import array, integer, real
 from .orientation import orient_curves
 from . import refinement
 from .validation import _as_degrees, _as_per_side, validate
 
 LABELS = {"D": "Dirichlet", "N": "Neumann", "I": "interface", "C": "contact"}
+#: the most elements :meth:`BoundaryMesh.polygon` builds (a dense BEM on 1e7 elements
+#: would need 1e14 matrix entries)
+MAX_ELEMENTS = 10 ** 7
 
 
 @dataclass(frozen=True, eq=False)
@@ -46,13 +50,19 @@ class BoundaryMesh:
 
     Parameters
     ----------
-    nodes : (nn, 2) float array
-    elements : (ne, 2) int array of node indices (direction = orientation)
-    labels : (ne,) str array, one label per element
-    degrees : (ne,) int array, polynomial degree p_I >= 1 of each element
-    parent : (ne,) int array or None; set by :meth:`refine` and :meth:`with_degrees`:
+    nodes
+        (nn, 2) float array
+    elements
+        (ne, 2) int array of node indices (direction = orientation)
+    labels
+        (ne,) str array, one label per element
+    degrees
+        (ne,) int array, polynomial degree p_I >= 1 of each element
+    parent
+        (ne,) int array or None; set by :meth:`refine` and :meth:`with_degrees`:
         ``parent[k]`` is the element of ``parent_mesh`` that contains element k
-    parent_mesh : the mesh this one was refined from (None for a built mesh)
+    parent_mesh
+        the mesh this one was refined from (None for a built mesh)
     """
 
     nodes: np.ndarray
@@ -113,7 +123,8 @@ class BoundaryMesh:
         oriented (outer curves counter-clockwise, holes clockwise; see the module
         docstring): the elements of a wrongly oriented curve are reversed, keeping
         their labels and degrees, so ``mesh.elements`` may differ from ``segments``."""
-        segments = np.asarray(segments)
+        nodes = array("nodes", nodes, shape=(None, 2))
+        segments = array("segments", segments, shape=(None, 2), dtype=np.int64)
         ne = len(segments)
         labels = np.asarray(_as_per_side(labels, ne, "labels"), dtype=str)
         degrees = _as_degrees(_as_per_side(p, ne, "p"), "p")
@@ -132,36 +143,28 @@ class BoundaryMesh:
         labels : str or list of str, one label per side (side k joins vertex k and k+1)
         p : int or list of int, polynomial degree per side
         """
-        try:
-            v = np.asarray(vertices, dtype=float)
-        except (TypeError, ValueError):
-            raise ValueError(f"vertices must be an (m, 2) array of numbers, got "
-                             f"{vertices!r}") from None
-        if v.ndim != 2 or v.shape[1] != 2 or len(v) < 3:
+        v = array("vertices", vertices, shape=(None, 2))      # finite numbers, (m, 2)
+        if len(v) < 3:
             raise ValueError(f"vertices must have shape (m, 2) with m >= 3, got {v.shape}")
         m = len(v)
         labels = _as_per_side(labels, m, "labels")
         ps = _as_per_side(p, m, "p")
         if n is None and h is None:
             n = 1
-        if n is not None:
-            ns = _as_per_side(n, m, "n")
-            for k in ns:
-                if isinstance(k, (bool, np.bool_)) or not isinstance(
-                        k, (int, float, np.integer, np.floating)) or not np.isfinite(k) \
-                        or int(k) != k or k < 1:
-                    raise ValueError(f"n (elements per side) must be integers >= 1, got {n!r}")
-        else:
-            hs = _as_per_side(h, m, "h")
-            for k in hs:
-                if isinstance(k, (bool, np.bool_)) or not isinstance(
-                        k, (int, float, np.integer, np.floating)) or not (
-                        np.isfinite(k) and k > 0):
-                    raise ValueError(f"h (element size) must be positive, got {h!r}")
+        if n is not None:     # elements per side: integers >= 1, never rounded
+            ns = [integer("n" if np.ndim(n) == 0 else f"n[{k}]", x, lo=1)
+                  for k, x in enumerate(_as_per_side(n, m, "n"))]
+        else:                 # element sizes: finite and positive
+            hs = [real("h" if np.ndim(h) == 0 else f"h[{k}]", x, positive=True)
+                  for k, x in enumerate(_as_per_side(h, m, "h"))]
         ps = list(_as_degrees(ps, "p"))
         side_len = np.linalg.norm(np.roll(v, -1, axis=0) - v, axis=1)
         if n is None:
             ns = [max(1, int(np.ceil(L / hk - 1e-9))) for L, hk in zip(side_len, hs)]
+        if sum(ns) > MAX_ELEMENTS:      # h = 1e-20 asked numpy for 1e20 nodes
+            name, value = ("h", h) if n is None else ("n", n)
+            raise ValueError(f"{name} gives {sum(ns):.3g} elements, more than "
+                             f"{MAX_ELEMENTS:.0e}: got {name}={value!r}")
         pts, lab, deg = [], [], []
         for k in range(m):
             t = np.arange(int(ns[k]))[:, None] / int(ns[k])
@@ -231,7 +234,7 @@ class BoundaryMesh:
 
     @property
     def normals(self) -> np.ndarray:
-        """Unit normals (t_y, -t_x): outward for counter-clockwise outer boundaries."""
+        """Unit normals (t_y, -t_x), outward for counter-clockwise outer boundaries."""
         t = self.tangents
         return np.column_stack([t[:, 1], -t[:, 0]])
 

@@ -9,10 +9,14 @@
 * :func:`contact_vtu` - the contact points of a contact result (on Gamma_C^s) as VTK
   vertices with the contact pressure p_n, tangential traction t_t, gaps g_n, g_t, slip
   and state (0 open, 1 stick, 2 slip).
-* :func:`write_pvd` - a ParaView collection (``.pvd``) of VTU files over load steps.
+* :func:`write_pvd` - a ParaView collection (``.pvd``) of VTU files over load steps;
+  :func:`write_vtu_series` writes the VTU files of a series and their collection.
 * :func:`write_vtu` writes such a ``meshio.Mesh``; experiments return them in
-  ``ArtefactResult.exports`` and :func:`hpfebe.suite.results.write_result` writes them next to
-  the other result files (``<out>/<artefact>_<key>.vtu``).
+  ``ArtefactResult.exports`` and :func:`hpfebe.suite.results.write_result` writes them into
+  the folder ``vtu/`` of the results (``results/vtu/<artefact>_<key>.vtu``; a series:
+  ``<artefact>_<key>_<k>.vtu`` and ``<artefact>_<key>.pvd``).
+* A BE body's interior field on a sampling mesh (representation formula):
+  :mod:`hpfebe.io.fields`.
 
 Like every file of the suite, the VTU is written to a temporary name in the target folder
 and renamed, so an interrupted run never leaves a half file; it gets the usual mode
@@ -42,9 +46,23 @@ def _umask() -> int:
 def write_vtu(path, mesh: meshio.Mesh, before_rename: Callable[[Path], None] | None = None
               ) -> Path:
     """Write a meshio mesh as VTU, atomically (temporary name, then rename).
-    ``before_rename(path)``, if given, is called just before the rename; if it raises,
-    the temporary file is removed and ``path`` is left as it was (the suite passes its
-    job watch: :func:`hpfebe.suite.watch.before_rename`)."""
+
+    Parameters
+    ----------
+    path : str or Path
+        the file, ending in ``.vtu``
+    mesh : meshio.Mesh
+        the mesh with its point and cell data (e.g. from :func:`fe_vtu`)
+    before_rename : callable, optional
+        called with ``path`` just before the rename; if it raises, the temporary file is
+        removed and ``path`` is left as it was (the suite passes its job watch,
+        :func:`hpfebe.suite.watch.before_rename`)
+
+    Returns
+    -------
+    Path
+        ``path``, with the usual mode (0644 under umask 022).
+    """
     path = Path(path)
     if path.suffix != ".vtu":
         raise ValueError(f"path must end in .vtu, got {str(path)!r}")
@@ -65,10 +83,26 @@ def write_vtu(path, mesh: meshio.Mesh, before_rename: Callable[[Path], None] | N
 
 def boundary_vtu(mesh: BoundaryMesh, space=None, fields: dict | None = None,
                  d: int = 1) -> meshio.Mesh:
-    """The boundary mesh, sampled at the Gauss-Lobatto points of every element, with
-    ``fields`` = {name: coefficients in ``space`` (V_hp or W_hp), d components
-    interleaved}.  Cells are line segments between consecutive samples; cell data
-    ``element`` and ``degree`` give the parent element and its p_I."""
+    """A boundary mesh as a VTU polyline, with fields in V_hp or W_hp.
+
+    Parameters
+    ----------
+    mesh : BoundaryMesh
+        sampled at the p_I + 1 Gauss-Lobatto points of every element
+    space : ContinuousSpace or DiscontinuousSpace, optional
+        the space of the fields (required with ``fields``)
+    fields : dict, optional
+        {name: coefficients in ``space``, ``d`` components interleaved}
+    d : int
+        the number of components of every field (1 or 2)
+
+    Returns
+    -------
+    meshio.Mesh
+        line segments between consecutive samples, point data ``fields`` (2-vectors
+        padded to 3D), cell data ``element`` and ``degree`` (the parent element and its
+        p_I).
+    """
     if not isinstance(mesh, BoundaryMesh):
         raise ValueError(f"mesh must be a BoundaryMesh, got {type(mesh).__name__}")
     fields = fields or {}
@@ -118,7 +152,7 @@ def _vtk_field(kind: str, name: str, v, n: int, what: str) -> np.ndarray:
 
 def fe_vtu(mesh, point_data: dict | None = None,
            cell_data: dict | None = None) -> meshio.Mesh:
-    """A scikit-fem MeshTri / MeshQuad as a VTU mesh.
+    """A scikit-fem MeshTri / MeshQuad with nodal and element fields as a VTU mesh.
 
     Parameters
     ----------
@@ -130,8 +164,16 @@ def fe_vtu(mesh, point_data: dict | None = None,
         {name: one value per element (e.g. a cell's plastic strain), shape
         (n_elements,), (n_elements, 2) or (n_elements, 2, 2)}
 
-    2-vectors are padded to 3D for VTK; 2x2 tensors become 4 components (xx, xy, yx,
-    yy).  ValueError on a wrong number of rows or non-finite values."""
+    Returns
+    -------
+    meshio.Mesh
+        2-vectors padded to 3D for VTK; 2x2 tensors as 4 components (xx, xy, yx, yy).
+
+    Raises
+    ------
+    ValueError
+        on a wrong number of rows or non-finite values.
+    """
     kinds = {3: "triangle", 4: "quad"}
     nverts = mesh.t.shape[0]
     if nverts not in kinds or mesh.p.shape[0] != 2:
@@ -162,11 +204,22 @@ CONTACT_FIELDS = ("p_n", "t_t", "g_n", "g_t", "slip", "state", "weights")
 
 
 def contact_vtu(result) -> meshio.Mesh:
-    """The contact points of ``result`` (a :class:`~hpfebe.contact.ContactResult`: its
-    ``points`` on the slave contact boundary) as VTK vertices, with point data
-    :data:`CONTACT_FIELDS`: pressure ``p_n`` >= 0, tangential traction ``t_t``, signed
-    gap ``g_n`` (< 0: penetration), relative tangential displacement ``g_t``, ``slip``,
-    ``state`` (0 open, 1 stick, 2 slip) and the quadrature ``weights``."""
+    """The contact state along Gamma_C^s as VTK vertices.
+
+    Parameters
+    ----------
+    result : ContactResult
+        a contact result (:class:`~hpfebe.contact.ContactResult`), or any object with
+        ``points`` (n, 2) on the slave contact boundary and the fields below
+
+    Returns
+    -------
+    meshio.Mesh
+        one vertex per contact point, with point data :data:`CONTACT_FIELDS`: pressure
+        ``p_n`` >= 0, tangential traction ``t_t``, signed gap ``g_n`` (< 0:
+        penetration), relative tangential displacement ``g_t``, ``slip``, ``state`` (0
+        open, 1 stick, 2 slip) and the quadrature ``weights``.
+    """
     pts = np.asarray(result.points, dtype=float)
     if pts.ndim != 2 or pts.shape[1] != 2:
         raise ValueError(f"result.points must have shape (n, 2), got {pts.shape}")
@@ -182,10 +235,24 @@ def write_contact_vtu(path, result) -> Path:
     return write_vtu(path, contact_vtu(result))
 
 
-def write_pvd(path, steps) -> Path:
-    """A ParaView collection ``path`` (``.pvd``) of ``steps`` = [(time, vtu path), ...]
-    (e.g. one VTU per load step; the paths are written relative to the collection's
-    folder), atomically and with the usual mode."""
+def write_pvd(path, steps, before_rename: Callable[[Path], None] | None = None) -> Path:
+    """A ParaView collection (``.pvd``) of VTU files, e.g. one per load step.
+
+    Parameters
+    ----------
+    path : str or Path
+        the collection, ending in ``.pvd``
+    steps : sequence of (float, str or Path)
+        (time or load factor, VTU file) pairs; the paths are written relative to the
+        collection's folder
+    before_rename : callable, optional
+        called with ``path`` just before the rename (see :func:`write_vtu`)
+
+    Returns
+    -------
+    Path
+        ``path``, written atomically (temporary name, then rename) with the usual mode.
+    """
     path = Path(path)
     if path.suffix != ".pvd":
         raise ValueError(f"path must end in .pvd, got {str(path)!r}")
@@ -201,8 +268,44 @@ def write_pvd(path, steps) -> Path:
         with os.fdopen(fd, "w") as fh:
             fh.write(text)
         os.chmod(tmp, 0o666 & ~_umask())
+        if before_rename is not None:
+            before_rename(path)
         os.replace(tmp, path)
     except BaseException:
         Path(tmp).unlink(missing_ok=True)
         raise
     return path
+
+
+def write_vtu_series(path, steps, before_rename: Callable[[Path], None] | None = None
+                     ) -> list[Path]:
+    """A load-step series for ParaView: ``<stem>_<k>.vtu`` (k = 0, 1, ...) beside the
+    collection ``path`` = ``<stem>.pvd``, which is written last.
+
+    Parameters
+    ----------
+    path : str or Path
+        the collection, ending in ``.pvd``
+    steps : sequence of (float, meshio.Mesh)
+        (time or load factor, mesh with its fields) per step, times increasing
+    before_rename : callable, optional
+        called before every rename (see :func:`write_vtu`)
+
+    Returns
+    -------
+    list of Path
+        the VTU files, then the collection.
+    """
+    path = Path(path)
+    if path.suffix != ".pvd":
+        raise ValueError(f"path must end in .pvd, got {str(path)!r}")
+    steps = list(steps)
+    if not steps:
+        raise ValueError("steps must hold at least one (time, mesh) pair, got none")
+    times = np.array([float(t) for t, _ in steps])
+    if not np.all(np.isfinite(times)) or np.any(np.diff(times) <= 0):
+        raise ValueError(f"steps: the times must be finite and strictly increasing, got "
+                         f"{times.tolist()}")
+    vtus = [write_vtu(path.with_name(f"{path.stem}_{k}.vtu"), mesh, before_rename)
+            for k, (_, mesh) in enumerate(steps)]
+    return [*vtus, write_pvd(path, list(zip(times, vtus)), before_rename)]

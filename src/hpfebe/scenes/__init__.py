@@ -18,15 +18,15 @@ the core (bodies, contact problems); experiments and tests import them.
   meshes, initial gap, the mortar contact problem on them, the hp-adaptive run.
 """
 
-from . import adaptive_bem, adaptive_fefe, interface, penalty, plasticity
+from . import adaptive_bem, adaptive_fefe, interface, penalty, plasticity, plasticity_fields
 from .materials import E, H, MU_F, NU, PLANE, SIGMA_Y, FrictionalContactScene
 from .stamping import (STAMP_KINDS, STAMP_SOLVER, Snapshot, StampContact, StepRecord,
                        TouchResult, TouchSteps,
                        be_work_piece, curve_difference, element_areas, field_difference,
                        lift_schedule, plastic_zone, stamp_body, stamp_interior, touch,
                        touch_be, work_piece, zone_mismatch)
-from .mortar import (adaptive_model_problem, contact_from_meshes, model_gap, model_meshes,
-                     model_problem)
+from .mortar import (ModelProblem, adaptive_model_problem, contact_from_meshes, model_gap,
+                     model_meshes, model_problem, mortar_contact_state)
 from .section44 import (READINGS, STAMP, WORK, X_POINT, DtNReadings, dtn_settings,
                         field_differences, mortar_bodies, penalty_bodies, penalty_scene,
                         penetration_l2, section44_scene, tangential_share)
@@ -41,6 +41,15 @@ __all__ += ["READINGS", "STAMP", "WORK", "X_POINT", "DtNReadings", "dtn_settings
             "field_differences", "mortar_bodies", "penalty_bodies", "penalty_scene",
             "penetration_l2", "section44_scene", "tangential_share"]
 __all__ += ["adaptive_bem", "adaptive_fefe", "interface", "penalty",
-            "plasticity"]    # scenes exported as modules
-__all__ += ["adaptive_model_problem", "contact_from_meshes", "model_gap", "model_meshes",
-            "model_problem"]
+            "plasticity", "plasticity_fields"]    # scenes exported as modules
+__all__ += ["ModelProblem", "adaptive_model_problem", "contact_from_meshes", "model_gap",
+            "model_meshes", "model_problem", "mortar_contact_state"]
+from . import (mortar, mortar_readings, mortar_runs, section44,  # noqa: E402
+               section44_fields, section44_figures, section44_readings, section44_runs)
+__all__ += ["mortar", "mortar_readings", "mortar_runs", "section44", "section44_fields",
+            "section44_figures", "section44_readings",
+            "section44_runs"]    # scenes exported as modules
+from . import bem_scaling  # noqa: E402
+__all__ += ["bem_scaling"]    # issue 27: dense against compressed BEM, as a module
+from . import adaptive_bem_readings, interface_readings, penalty_readings  # noqa: E402
+__all__ += ["adaptive_bem_readings", "interface_readings", "penalty_readings"]  # Ch. 2-3

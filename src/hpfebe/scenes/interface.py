@@ -29,9 +29,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..analysis import observed_rates
 from ..coupling.coercivity import coercivity_threshold, inverse_constant, lemma_2_2_3_bound
-from ..coupling.errors import (BEDomainSetup, be_domain_errors_both, be_trace_energy_error,
-                               fe_errors)
+from ..coupling.errors import (BEDomainSetup, be_domain_errors_both, be_solution_at,
+                               be_trace_energy_error, fe_errors)
 from ..coupling.nitsche import DEFAULT_ALPHA, DEFAULT_H_DEF, InterfaceProblem, NitscheFEBE
 
 log = logging.getLogger(__name__)
@@ -370,3 +371,112 @@ def coercivity_rows(prm: CoercivityScene, progress=_each) -> list[dict]:
                              C_inv=np.nan, young_bound=np.nan, lemma_bound=np.nan,
                              wall_time_s=time.perf_counter() - t1))
     return rows
+
+
+# ----------------------------------------------------------------------- tables, choices
+def part_table(sweep, part: str, h_col: str) -> dict:
+    """Columns of the published-format table of one part ("fe" or "be") of the sweep
+    ``sweep`` (columns of :func:`sweep_rows`, a mapping column -> values): series, h_inv,
+    p, errors and observed rates (w.r.t. h^-1 for series h at fixed p, w.r.t. p for
+    series p on its mesh), then dof and timings; the BE part adds the H1 error of the
+    same interpolant of the exact u and the trace energy error |u - U2|_W on Gamma2 with
+    its rate.  Rows grouped by series and key in the order of the sweep."""
+    c = {k: np.asarray(v) for k, v in sweep.items()}
+    groups = []
+    for series in dict.fromkeys(c["series"]):
+        rows = np.flatnonzero(c["series"] == series)
+        key, x = (c["p"], c[h_col]) if series == "h" else (c[h_col], c["p"])
+        for k in dict.fromkeys(key[rows]):
+            g = rows[key[rows] == k]
+            groups.append((g[np.argsort(x[g], kind="stable")], x))
+    idx = np.concatenate([g for g, _ in groups])
+
+    def rate(col):
+        return np.concatenate([observed_rates(1.0 / np.asarray(x[g], float),
+                                              np.asarray(c[col][g], float))
+                               for g, x in groups])
+    out = dict(series=c["series"][idx], h_inv=c[h_col][idx].astype(int), p=c["p"][idx],
+               l2_error=c[f"{part}_l2"][idx], l2_rate=rate(f"{part}_l2"),
+               h1_error=c[f"{part}_h1"][idx], h1_rate=rate(f"{part}_h1"), dof=c["dof"][idx],
+               wall_time_s=c["wall_time_s"][idx], fe_h_inv=c["fe_h_inv"][idx],
+               be_h_inv=c["be_h_inv"][idx], lambda_nit=c["lambda_nit"][idx])
+    if part == "be" and "be_energy" in c:
+        out.update(h1_interp_exact=c["be_h1_interp"][idx],
+                   trace_energy_error=c["be_energy"][idx],
+                   trace_energy_rate=rate("be_energy"))
+    return out
+
+
+def work_precision_rows(prm: ConvergenceScene, rows: list[dict]) -> list[dict]:
+    """The rows of a sweep (:func:`sweep_rows`) with the minimum over ``timing_repeats``
+    measurements of assembly, solve and their sum, and the slowest sum
+    (wall_time_max_s): the sweep's own timing and timing_repeats - 1 more, interleaved
+    over the cases so that a slow phase of the machine does not hit one case only."""
+    asm = [np.array([r["assembly_s"] for r in rows])]
+    sol = [np.array([r["solve_s"] for r in rows])]
+    for _ in range(prm.timing_repeats - 1):
+        a, s = np.array([timed_solve(problem(r["problem"]), r["fe_h_inv"], r["be_h_inv"],
+                                     r["p"], prm) for r in rows]).T
+        asm.append(a)
+        sol.append(s)
+    asm, sol = np.array(asm), np.array(sol)
+    return [dict(r, assembly_s=a, solve_s=s, wall_time_s=t, wall_time_max_s=tmax)
+            for r, a, s, t, tmax in zip(rows, asm.min(axis=0), sol.min(axis=0),
+                                        (asm + sol).min(axis=0), (asm + sol).max(axis=0))]
+
+
+def solution_fields(name: str, fe_h: float, be_h: float, lambda_nit: float):
+    """The computed solution of Figures 2.1 / 2.3 (p = 1): (model, solution, mesh of
+    Omega2 of size 1/(2 be_h), the BE part there by the representation formula)."""
+    pb = problem(name)
+    model = NitscheFEBE(pb, fe_h, be_h, 1)
+    sol = model.solve(lambda_nit)
+    d2 = pb.omega2_domain(2 * be_h).mesh
+    return model, sol, d2, be_solution_at(model, sol.U2, d2.p.T)
+
+
+#: Examples 1, 2: the choices where the thesis is silent (repeated in the notes)
+CONVERGENCE_CHOICES = (
+    "alpha = 0 in the penalty lambda_Nit h1^-1 p1^alpha, and h1 = the length of the FE edge "
+    "on Gamma_I (not diam K): with them Table 2.2 (h^-1 = 2, p = 1, 2, 3) and Table 2.4 (h- "
+    "and p-version) are reproduced to the printed digits.",
+    "FE meshes: per-block tensor grids with the cell count of the uniform grid; in Example 1 "
+    "the blocks y in [-1,-1/2] / [1/2,1] of odd h^-1 get floor/ceil(h^-1/2) rows (75 "
+    "elements for h = 1/5 as in the thesis).  BE meshes: ceil(|side| h^-1) equal elements "
+    "per side.",
+    "The p-version of Example 2 uses FE h^-1 = 4 and BE h^-1 = 6 (the table headers), not the "
+    "h1 = 1/6, h2 = 1/8 of the caption of Figure 2.4: the FE errors of Table 2.4 are then "
+    "reproduced exactly for p = 1..7.",
+    "BE-part errors: domain L2 / H1-seminorm errors in Omega2 of the Q_p equidistant-node "
+    "interpolant, on a mesh of Omega2 of the BE mesh size, of the representation-formula "
+    "solution (nodal values U2 on dOmega2): the measure that reproduces Table 2.1 and the "
+    "h-version of Table 2.3 (hpfebe.coupling.errors explains why other measures do not). "
+    "BE tables add the H1 error of the same interpolant of the exact u and the trace energy "
+    "error |u - U2|_W on Gamma2 with its rate (the BE part of the norm of Theorem 2.2.3).",
+    "DOF = FE + BE unknowns without Gamma_D.",
+)
+
+#: Example 3: the choices where the thesis is silent
+LAMBDA_CHOICES = (
+    "alpha = 0, h1 = edge length, BE-part post-processing and meshes as in "
+    "ch2_convergence.",
+    "'Does not converge': the last FE energy rate (w.r.t. h^-1) is below 0.3.",
+    "'Reduced rate': the last FE energy rate is more than 0.3 below the lambda = 20 rate, "
+    "or the BE energy rate is.",
+    "'Almost the same convergence rates' (smooth, lambda = 10 and 20): the last rates of "
+    "all four error curves of every p within 0.15 (the rate tolerance of the tables) of "
+    "lambda = 20.",
+    "'The same curves': all errors (FE and BE, L2 and energy) within 5 % of lambda = 20.",
+    "Coercivity: lambda*(p) of each mesh of the sweep (same alpha and h1) - a_h is "
+    "positive definite iff lambda_Nit > lambda*.",
+    "The lambda_Nit sweep is on the meshes up to FE h^-1 = 23 (smooth) and 64 (singular) "
+    "in the full configuration.",
+)
+
+#: the coercivity threshold: the choices where the thesis is silent
+COERCIVITY_CHOICES = (
+    "alpha = 0, h1 = edge length: the setting that reproduces the thesis's tables.",
+    "alpha = 1, 2 rows are lambda*(0) p^-alpha (exact for uniform p).",
+    "Lemma bound as printed with gamma = 2 and the computed C_inv of (2.7); young_bound = "
+    "C_inv p^(2-alpha) is the sharp version of the lemma's argument.",
+)

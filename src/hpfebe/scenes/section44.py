@@ -18,22 +18,32 @@ lifted by 1e-4; E = 266926, nu = 0.29, sigma_Y = 4.0, H = 450.0
 * :func:`mortar_bodies`, :func:`penalty_bodies`, :func:`field_differences` - both
   bodies' fields of either solution and their relative differences on common points
   (the comparison of Figures 4.21 and 4.22).
+* :class:`Section44Scene` - the parameters of both methods (config section
+  ``ch4_section44``), the published colour bars of Figures 4.21, 4.22 (:data:`PUB_UX`,
+  ...), and the sensitivity variants every explanation must survive
+  (:func:`sensitivity_variants`, :data:`VARIANT_TEXT`).  The runs:
+  :mod:`hpfebe.scenes.section44_runs`; the fields compared and exported:
+  :mod:`.section44_fields`; the readings of Tables 4.2, 4.3 and of the figures' colour
+  bars: :mod:`.section44_readings`, :mod:`.section44_figures`.
 """
 
 from __future__ import annotations
+
+from dataclasses import dataclass, replace
 
 import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from ..checks import array, real
+from ..checks import array, choice, integer, real
 from ..constitutive.j2 import J2Material
+from ..contact import ContactSettings
 from ..contact.mortar_fe import FEMortarContact
 from ..solvers import DtNSettings, UzawaSettings
 from ..fem.elasticity import ElasticBody, rectangle_mesh
 from ..fem.plastic_body import ElastoPlasticFE
 from .materials import E, H, NU, SIGMA_Y
-from .stamping import stamp_body, stamp_interior
+from .stamping import StampContact, stamp_body, stamp_interior
 
 #: the stamp Omega_s and the work piece Omega_m, (x0, x1, y0, y1)
 STAMP = (-0.5, 0.5, 0.0, 2.0)
@@ -90,6 +100,175 @@ def penetration_l2(c) -> float:
     return float(np.sqrt(w @ np.asarray(np.maximum(-c.g_n, 0.0)) ** 2))
 
 
+# --------------------------------------------------------------------------- parameters
+# Figure 4.22 colorbars (report/published/scalars.csv): work piece first, then stamp
+PUB_UX = {"work": (-0.9184e-5, 0.9184e-5), "stamp": (-0.8495e-5, 0.8495e-5)}
+PUB_UY = {"work": (0.5293e-4, 0.9600e-4), "stamp": (-0.5079e-7, 0.5893e-4)}
+PUB_DEV_MAX = 3.302
+# Figure 4.21 colorbars (report/published/scalars.csv): work piece first, then stamp
+PUB_MORTAR_UX = {"work": (-0.8262e-5, 0.8262e-5), "stamp": (-0.8486e-5, 0.8486e-5)}
+PUB_MORTAR_UY = {"work": (0.5563e-4, 0.9600e-4), "stamp": (0.0, 0.6254e-4)}
+PUB_MORTAR_DEV_MAX = 3.306
+
+
+@dataclass(frozen=True)
+class Section44Scene:
+    """The parameters of Section 4.4's two methods (config section ``ch4_section44``).
+
+    Penalty (Table 4.3, Figure 4.22): material E, nu, sigma_Y, H, theta; Coulomb mu_f;
+    1/eps_n = f E for f in ``eps_n_factors`` (1/eps_t = eps_t_ratio of it), Figure 4.22
+    at ``figure_factor``; the lift in ``n_load`` increments, Newton (rtol, max_newton,
+    max_cuts); the BE stamp (h_stamp, be_degree) and the work piece mesh
+    (``penalty_mesh``: "mortar" = work_cells, "h_work" = uniform h_work cells; its
+    ``penalty_formulation``); ``two_pass``: the contact in two passes, each body the
+    slave once (``compare_passes``: the sweep also with the other treatment);
+    ``h_work_fine`` > 0: the sweep again on that mesh; ``penalty_law`` "coulomb" (mu_f)
+    or "tresca" (the mortar's F).  Mortar (Table 4.2, Figure 4.21): Tresca F, Uzawa step
+    rho, TOL_DtN, TOL_U, Newton tolerance and caps of step 2, the damping grid
+    omegas_D x omegas_N, the figure's dampings, the Q1 meshes stamp_cells, work_cells
+    and the work piece's formulation.  The claims' tolerances: slope_tol, range_tol,
+    pen_factor, iteration_factor, alt_tol_dtn and the scanned fit_tols."""
+
+    E: float = E
+    nu: float = NU
+    sigma_Y: float = SIGMA_Y
+    H: float = H
+    theta: float = 1.0
+    mu_f: float = 0.2
+    eps_n_factors: tuple[float, ...] = (20.0, 10.0, 5.0, 2.5)
+    eps_t_ratio: float = 0.5
+    figure_factor: float = 10.0
+    lift: float = 1e-4
+    n_load: int = 5
+    h_work: float = 1.0 / 11.0
+    h_stamp: float = 0.1
+    be_degree: int = 1
+    rtol: float = 1e-8
+    max_newton: int = 40
+    max_cuts: int = 4
+    slope_tol: float = 0.15            # penetration ~ eps^1: |slope - 1| <= slope_tol
+    range_tol: float = 0.1             # colour-bar extremes within 10 % of the published ones
+    pen_factor: float = 2.0            # penetration norms within a factor 2
+    two_pass: bool = True
+    compare_passes: bool = True
+    h_work_fine: float = 0.0           # > 0: the sweep again on this work piece mesh
+    penalty_mesh: str = "mortar"
+    penalty_formulation: str = "full"
+    compare_variants: bool = True      # extra runs splitting the mortar-penalty difference
+    penalty_law: str = "coulomb"
+    F: float = 0.22                    # given (Tresca) friction
+    rho: float = 8.264e5               # Uzawa step (absolute)
+    tol_dtn: float = 1e-6
+    tol_uzawa: float = 1e-6
+    newton_tol: float = 1e-8           # step 2 (thesis TOL_N = 1e-4, see MORTAR_CHOICES)
+    max_dtn: int = 50                  # DtN cap: reaching it = no convergence
+    newton_max_iter: int = 15          # step 2 cap (converged runs need <= 8)
+    max_uzawa: int = 2000
+    coupling_tol: float = 1e-3
+    omegas_D: tuple[float, ...] = (0.3, 0.5, 0.7, 0.9)
+    omegas_N: tuple[float, ...] = (0.3, 0.5, 0.7, 0.9, 1.0)
+    figure_omegas: tuple[float, ...] = (0.5, 0.7)
+    stamp_cells: tuple[int, ...] = (10, 20)      # 11 x 21 = 231 nodes
+    work_cells: tuple[int, ...] = (61, 31)       # 62 x 32 = 1984 nodes
+    mortar_formulation: str = "full"
+    iteration_factor: float = 1.3      # DtN counts within 30 %
+    alt_tol_dtn: float = 1e-4          # the counts also at this looser TOL_DtN (same runs)
+    # relative tolerances scanned for the one that fits Table 4.2 (tolerance_fit_claim)
+    fit_tols: tuple[float, ...] = (1e-3, 3e-4, 1e-4, 3e-5, 1e-5)
+    monolithic: bool = True            # also the monolithic semismooth Newton
+
+    def __post_init__(self):
+        for name in ("stamp_cells", "work_cells", "figure_omegas"):
+            if len(getattr(self, name)) != 2:
+                raise ValueError(f"{name} must have two entries, got {getattr(self, name)!r}")
+        if not self.eps_n_factors or any(not f > 0 for f in self.eps_n_factors):
+            raise ValueError(f"eps_n_factors must be positive, got {self.eps_n_factors!r}")
+        if self.figure_factor not in self.eps_n_factors:
+            raise ValueError(f"figure_factor must be one of eps_n_factors "
+                             f"{self.eps_n_factors!r}, got {self.figure_factor!r}")
+        for name in ("tol_dtn", "tol_uzawa", "newton_tol", "coupling_tol", "alt_tol_dtn",
+                     "rho", "iteration_factor", "slope_tol", "range_tol", "pen_factor",
+                     "lift", "h_work", "h_stamp", "eps_t_ratio", "rtol"):
+            real(name, getattr(self, name), positive=True)   # a tolerance <= 0: never met
+        for name in ("mu_f", "F", "h_work_fine"):
+            real(name, getattr(self, name), nonnegative=True)
+        integer("max_cuts", self.max_cuts, lo=0)
+        for name in ("n_load", "max_newton", "max_dtn", "newton_max_iter", "max_uzawa",
+                     "be_degree"):
+            integer(name, getattr(self, name), lo=1)
+        for name in ("omegas_D", "omegas_N", "figure_omegas"):       # dampings
+            for w in getattr(self, name) or [None]:
+                real(name, w, lo=0.0, hi=1.0, lo_open=True)
+        for name in ("stamp_cells", "work_cells"):
+            for n in getattr(self, name) or [None]:
+                integer(name, n, lo=1)
+        if not self.fit_tols or any(not self.tol_dtn <= t < 1 for t in self.fit_tols):
+            raise ValueError(f"fit_tols must lie in [tol_dtn, 1), got {self.fit_tols!r}")
+        for name, allowed in (("penalty_mesh", ("mortar", "h_work")),
+                              ("penalty_law", ("coulomb", "tresca")),
+                              ("penalty_formulation", ("full", "bbar")),
+                              ("mortar_formulation", ("full", "bbar"))):
+            choice(name, getattr(self, name), allowed)
+
+    def settings(self, factor: float) -> StampContact:
+        """Penalty 1/eps_n = factor E, 1/eps_t = eps_t_ratio factor E; Coulomb mu_f or
+        (penalty_law 'tresca') the mortar's Tresca bound F; Newton (rtol, max_newton,
+        max_cuts, line search, bonded predictor)."""
+        return StampContact(factor, self.eps_t_ratio * factor, self.mu_f,
+                            F=self.F if self.penalty_law == "tresca" else None,
+                            two_pass=self.two_pass, solver=ContactSettings(
+                                rtol=self.rtol, max_iter=self.max_newton,
+                                max_cuts=self.max_cuts, line_search=True, predictor=True))
+
+    @property
+    def penalty_cells(self) -> tuple[int, int]:
+        """(nx, ny) Q1 cells of the penalty work piece."""
+        if self.penalty_mesh == "mortar":
+            return int(self.work_cells[0]), int(self.work_cells[1])
+        return tuple(max(1, int(round((hi - lo) / self.h_work)))
+                     for lo, hi in ((WORK[0], WORK[1]), (WORK[2], WORK[3])))
+
+    def material(self) -> J2Material:
+        return J2Material(self.E, self.nu, self.sigma_Y, self.H, self.theta)
+
+    def fine(self) -> "Section44Scene":
+        """The parameters of the penetration sweep on the uniform h_work_fine mesh."""
+        return replace(self, h_work=self.h_work_fine or self.h_work, penalty_mesh="h_work")
+
+    def frictionless(self) -> "Section44Scene":
+        return replace(self, mu_f=0.0, penalty_law="coulomb")
+
+    def elastic(self) -> "Section44Scene":
+        """The same scene with a work piece that never yields (sigma_Y x 1e12)."""
+        return replace(self, sigma_Y=1e12 * self.sigma_Y)
+
+
+#: the changes the explanations of both figures must survive (issue 22): the parameters
+#: of :func:`sensitivity_variants`
+VARIANT_TEXT = {
+    "table": "the table's meshes",
+    "alignment": "one work piece cell more across (the nodes of Gamma^m_C shifted against "
+                 "the stamp's)",
+    "load_steps": "4 x n_load load increments (the penalty runs; the mortar DtN is one "
+                  "step from the virgin state, unchanged)",
+    "refinement": "both bodies refined: the work piece on the h_work_fine mesh (without "
+                  "one: twice its cells), the stamp's cells doubled and h_stamp halved",
+}
+
+
+def sensitivity_variants(prm: Section44Scene) -> dict[str, Section44Scene]:
+    """The parameters of :data:`VARIANT_TEXT` ("table": ``prm`` itself).  The work piece
+    cells are the mortar's ``work_cells`` and, with penalty_mesh 'mortar', the
+    penalty's."""
+    nx, ny = prm.work_cells
+    fine = prm.fine().penalty_cells if prm.h_work_fine > 0 else (2 * nx, 2 * ny)
+    return {"table": prm,
+            "alignment": replace(prm, work_cells=(nx + 1, ny)),
+            "load_steps": replace(prm, n_load=4 * prm.n_load),
+            "refinement": replace(prm, work_cells=fine, h_stamp=prm.h_stamp / 2,
+                                  stamp_cells=tuple(2 * c for c in prm.stamp_cells))}
+
+
 # --------------------------------------------------------------------------- readings
 #: Readings of the DtN stopping rule (Algorithm 4.3, step 7: "stop if ||P^k - P^k-1|| <=
 #: TOL_DtN ||P^k-1||"), recorded per iteration by :class:`DtNReadings`: the quantity (P:
@@ -107,6 +286,19 @@ def penetration_l2(c) -> float:
 READINGS = ("P_l2_prev", "P_l2_new", "P_max_prev", "P_L2gamma_prev", "P_l2_first",
             "U2_l2_prev", "U2_max_prev", "U2_energy_prev", "U2_contact_prev", "P_n_l2_prev",
             "P_t_l2_prev")
+#: what each reading of :data:`READINGS` measures (the bound "P_t_l2_prev" left out)
+READING_TEXT = {
+    "P_l2_prev": "P, l2, relative to P^k-1 (the printed rule)",
+    "P_l2_new": "P, l2, relative to P^k (fixed_point's; the table's stop)",
+    "P_max_prev": "P, max-norm, relative to P^k-1",
+    "P_L2gamma_prev": "P as function, L2(Gamma_C), relative to P^k-1",
+    "P_l2_first": "P, l2, relative to the first nonzero P",
+    "U2_l2_prev": "U2, l2 (all dofs), relative to U2^k-1",
+    "U2_max_prev": "U2, max-norm, relative to U2^k-1",
+    "U2_energy_prev": "U2, elastic energy norm, relative to U2^k-1",
+    "U2_contact_prev": "U2 on Gamma_C, l2, relative to U2^k-1",
+    "P_n_l2_prev": "the normal components of P alone, l2, relative to P_n^k-1",
+}
 
 
 def _rel(num, den) -> float:
@@ -243,6 +435,8 @@ def field_differences(a: dict, b: dict) -> list[dict]:
     return rows
 
 
-__all__ = ["READINGS", "STAMP", "WORK", "X_POINT", "DtNReadings", "dtn_settings",
-           "field_differences", "mortar_bodies", "penalty_bodies", "penalty_scene",
-           "penetration_l2", "section44_scene", "tangential_share"]
+__all__ = ["PUB_DEV_MAX", "PUB_MORTAR_DEV_MAX", "PUB_MORTAR_UX", "PUB_MORTAR_UY", "PUB_UX",
+           "PUB_UY", "READINGS", "READING_TEXT", "STAMP", "VARIANT_TEXT", "WORK", "X_POINT",
+           "DtNReadings", "Section44Scene", "dtn_settings", "field_differences",
+           "mortar_bodies", "penalty_bodies", "penalty_scene", "penetration_l2",
+           "section44_scene", "sensitivity_variants", "tangential_share"]

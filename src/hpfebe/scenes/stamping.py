@@ -210,7 +210,7 @@ class TouchSteps:
     lambda in (k - 1, k] is increment k of the lift schedule ``lifts`` (g_0 = 0), the
     prescribed lift ramped linearly from g_{k-1} to g_k on the dofs ``is_y``; the start of
     an increment is :meth:`extrapolated`; after each converged increment
-    ``on_increment(k, result)`` is called with the :class:`ContactResult` of its last
+    ``on_increment(k, result)`` is called with the :class:`~hpfebe.contact.ContactResult` of its last
     step (its ``info`` the increment's attempts)."""
 
     def __init__(self, pr: TwoBodyContact, fixed, is_y, lifts, work_y,

@@ -36,7 +36,7 @@ from typing import Any, Callable, Protocol
 
 import numpy as np
 
-from ..checks import boolean, choice, instance, integer, real
+from ..checks import boolean, choice, instance, integer, real, tolerance
 from .fixed_point import fixed_point
 from .info import SolverInfo
 from .uzawa import UzawaSettings, _set
@@ -69,8 +69,8 @@ class DtNSettings:
         for name in ("omega_D", "omega_N"):         # "must lie in (0, 1]"
             _set(self, name, real(name, getattr(self, name), lo=0.0, hi=1.0,
                                   lo_open=True))
-        for name in ("tol", "divergence"):
-            _set(self, name, real(name, getattr(self, name), positive=True))
+        _set(self, "tol", tolerance("tol", self.tol))
+        _set(self, "divergence", real("divergence", self.divergence, positive=True))
         _set(self, "max_iter", integer("max_iter", self.max_iter, lo=1))
         _set(self, "aitken", boolean("aitken", self.aitken))
         choice("transfer", self.transfer, TRANSFERS)

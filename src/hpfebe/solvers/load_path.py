@@ -28,12 +28,37 @@ class LoadStep(Protocol):
 
 def load_path(steps: LoadStep, factors, x0: np.ndarray, max_cuts: int = 0,
               lam0: float = 0.0, cuts_per_step: bool = False, **newton_kw):
-    """Algorithm 4.1: Newton for every load factor of the sequence ``factors`` (usually
-    increasing; an unloading path may turn back, no factor repeats the one before), the history committed after each converged step; a failed step is cut
-    in half and retried from the committed state, at most ``max_cuts`` times in all
-    (``cuts_per_step``: at most ``max_cuts`` times between two factors of ``factors``).
-    Returns (last iterate, SolverInfo with one SolverInfo per attempted step in
-    ``steps``)."""
+    """Algorithm 4.1: Newton for every load factor of a sequence, the history committed
+    after each converged step; a failed step is cut in half and retried from the
+    committed state.
+
+    Parameters
+    ----------
+    steps : LoadStep
+        the problem at each load factor (``problem``, ``start``, ``commit``, ``record``)
+    factors : sequence of float
+        the load factors, usually increasing (an unloading path may turn back); none
+        repeats the one before
+    x0 : ndarray
+        the start of the first step
+    max_cuts : int
+        how many times a failed step may be halved, in all (default 0: no cuts)
+    lam0 : float
+        the load factor of ``x0`` (default 0)
+    cuts_per_step : bool
+        count ``max_cuts`` between two factors of ``factors`` instead of in all
+    **newton_kw
+        passed to :func:`~hpfebe.solvers.newton` (``tol`` is required)
+
+    Returns
+    -------
+    it : Iterate
+        the last iterate; the solution is ``it.x``
+    info : SolverInfo
+        ``converged`` and ``reason`` of the path, the Newton iterations in all, and in
+        ``info.steps`` one SolverInfo per attempted step (cuts included), each with its
+        ``load_factor``
+    """
     factors = array("load factors", factors, ndim=1, min_size=1)
     lam0 = real("lam0", lam0)
     # loading and unloading alike (a path may turn back); a repeated factor is a step of

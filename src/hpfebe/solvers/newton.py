@@ -50,8 +50,41 @@ def newton(problem: NewtonProblem, x0: np.ndarray, tol: float, max_iter: int = 5
            atol: float = 0.0, norm=np.inf, line_search: LineSearch | None = None,
            predictor: Callable[[Iterate], np.ndarray | None] | None = None,
            roundoff_stop: bool = False, divergence: float = 1e12):
-    """Semismooth Newton from x0.  Returns (final iterate, SolverInfo).
+    """Semismooth Newton from x0.
 
+    Parameters
+    ----------
+    problem : NewtonProblem
+        ``evaluate(x) -> Iterate``, ``step(it) -> dx``, ``slope(it, dx)``
+    x0 : ndarray
+        the start
+    tol : float
+        the relative tolerance of the stopping test (required)
+    max_iter : int
+        at most this many iterations (default 50)
+    atol : float
+        the absolute part of the stopping test (default 0)
+    norm : float
+        the order of the residual norm (default inf)
+    line_search : LineSearch, optional
+        the backtracking rule (default ``LineSearch()``)
+    predictor : callable, optional
+        ``predictor(it) -> x or None``, a first candidate (see below)
+    roundoff_stop : bool
+        stop at round-off level updates (see below; default False)
+    divergence : float
+        the factor of the divergence test (default 1e12)
+
+    Returns
+    -------
+    it : Iterate
+        the final iterate; the solution is ``it.x``
+    info : SolverInfo
+        ``converged``, ``reason``, ``iterations``, the residual history and
+        ``backward_error``
+
+    Notes
+    -----
     Stopping test (the backward-error rule of :mod:`.info`): ||R|| <= atol + tol * scale,
     ``atol`` tol times a reference force of the problem's data (never a constant: a
     floor above the forces of the data accepts a wrong start).

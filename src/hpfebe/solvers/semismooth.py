@@ -16,7 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..checks import integer, real
+from ..checks import integer, tolerance
 from ..constitutive.laws import friction_projection, normal_projection
 from .info import Iterate, SingularStep
 from .newton import newton
@@ -35,7 +35,7 @@ class SemismoothSettings:
 
     def __post_init__(self):
         check_friction(self)
-        _set(self, "tol", real("tol", self.tol, positive=True))
+        _set(self, "tol", tolerance("tol", self.tol))
         _set(self, "max_iter", integer("max_iter", self.max_iter, lo=1))
 
 

@@ -15,7 +15,7 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit
 
-from ..checks import boolean, choice, integer, real
+from ..checks import boolean, choice, integer, real, tolerance
 from ..constitutive.laws import friction_projection, normal_projection, tresca_return
 from .fixed_point import fixed_point
 from .pcg import BoundQP, _per_node, _polyak_core, pcg_info
@@ -38,8 +38,9 @@ class UzawaSettings:
     cg_tol: float = 1e-11
 
     def __post_init__(self):
-        for name in ("rho", "tol", "cg_tol"):
-            _set(self, name, real(name, getattr(self, name), positive=True))
+        _set(self, "rho", real("rho", self.rho, positive=True))
+        for name in ("tol", "cg_tol"):
+            _set(self, name, tolerance(name, getattr(self, name)))
         _set(self, "max_iter", integer("max_iter", self.max_iter, lo=1))
         _set(self, "relative", boolean("relative", self.relative))
 
@@ -152,7 +153,8 @@ class GlobalUzawaSettings:
 
     def __post_init__(self):
         check_friction(self)
-        for name in ("rho", "tol", "divergence"):
+        _set(self, "tol", tolerance("tol", self.tol))
+        for name in ("rho", "divergence"):
             _set(self, name, real(name, getattr(self, name), positive=True))
         _set(self, "max_iter", integer("max_iter", self.max_iter, lo=1))
         _set(self, "relative", boolean("relative", self.relative))

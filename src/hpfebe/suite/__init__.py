@@ -40,7 +40,8 @@ _API = {
     "compile_kernels": "warmup",
     "new_figure": "figures", "style_axes": "figures", "reference_slope": "figures",
     "slope_line": "figures", "readable_log_ticks": "figures",
-    "published_table": "tables", "grouped_rates": "tables",
+    "mesh_sequence_figure": "figures", "deformed_field_figure": "figures",
+    "published_table": "tables", "grouped_rates": "tables", "published_ratio": "tables",
     "select_scenes": "runs", "from_config_sections": "runs", "timed": "runs",
 }
 

@@ -59,15 +59,23 @@ CELLS_PREFIX = "cells:"
 class Claim:
     """A checked statement about an artefact.
 
-    text : the statement, e.g. "BE energy rate of the h-version ~0.66 (theory 2/3)"
-    holds : True (holds), False (differs), None (not decidable here, e.g. evaluated
-        over zero converged runs)
-    evidence : the measured numbers that decide it
-    kind : one of :data:`CLAIM_KINDS` (default ``"thesis"``)
-    id : a short name, unique within the artefact, that ``explains`` entries refer to
-    explains : for ``explanation`` and ``hypothesis`` claims: the ids of the claims of
-        the same artefact, and the cells (:data:`CELLS_PREFIX`), whose difference this
-        claim accounts for
+    Parameters
+    ----------
+    text : str
+        the statement, e.g. "BE energy rate of the h-version ~0.66 (theory 2/3)"
+    holds : bool or None
+        True (holds), False (differs), None (not decidable here, e.g. evaluated over
+        zero converged runs)
+    evidence : str
+        the measured numbers that decide it
+    kind : str
+        one of :data:`CLAIM_KINDS` (default ``"thesis"``)
+    id : str
+        a short name, unique within the artefact, that ``explains`` entries refer to
+    explains : tuple of str
+        for ``explanation`` and ``hypothesis`` claims: the ids of the claims of the
+        same artefact, and the cells (:data:`CELLS_PREFIX`), whose difference this claim
+        accounts for
     """
 
     text: str

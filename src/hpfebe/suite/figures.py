@@ -14,12 +14,16 @@ and closes them.  Plotting lives here and in the experiments, never in numerical
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
+from matplotlib.collections import LineCollection
 from matplotlib.figure import Figure
 from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter
+from mpl_toolkits.axes_grid1 import make_axes_locatable
 
 __all__ = ["new_figure", "style_axes", "reference_slope", "slope_line",
-           "readable_log_ticks", "GRID"]
+           "readable_log_ticks", "GRID", "mesh_sequence_figure", "deformed_field_figure"]
 
 #: the grid of every convergence and work-precision plot: major and minor ticks, faint
 GRID = dict(which="both", alpha=0.3)
@@ -81,3 +85,58 @@ def readable_log_ticks(axis, numticks=None) -> None:
     axis.set_major_locator(LogLocator(subs=(1.0, 2.0, 5.0), numticks=numticks))
     axis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
     axis.set_minor_formatter(NullFormatter())
+
+
+def mesh_sequence_figure(panels, title: str, columns: int = 4):
+    """A figure of a sequence of boundary meshes (adaptive refinement), one panel per
+    entry of ``panels``: (mesh, marked, polygon, panel title) with the elements of
+    ``mesh`` (its ``a``, ``b`` end points) in black, the ``marked`` ones in red, and the
+    closed ``polygon`` (e.g. the deformed boundary) in blue; at most ``columns`` panels
+    per row."""
+    n = len(panels)
+    cols = min(columns, n)
+    rows = int(math.ceil(n / cols))
+    fig, axs = new_figure((3.0 * cols, 3.1 * rows), rows, cols)
+    axs = np.atleast_1d(axs).ravel()
+    for ax, (mesh, marked, P, name) in zip(axs, panels):
+        marked = np.asarray(marked, dtype=bool)
+        segs = np.stack([mesh.a, mesh.b], axis=1)             # (n_elements, 2, 2)
+        # one collection per style (not one line per element: cheaper to draw)
+        for sel, c, lw in ((~marked, "k", 0.8), (marked, "red", 2.0)):
+            if sel.any():
+                ax.add_collection(LineCollection(segs[sel], colors=c, linewidths=lw))
+        ax.plot(mesh.a[:, 0], mesh.a[:, 1], "k.", ms=3)
+        ax.plot(P[:, 0], P[:, 1], "b-", lw=0.8)
+        ax.set_title(name, fontsize="small")
+        ax.set_aspect("equal")
+        ax.set_xticks([])
+        ax.set_yticks([])
+    for ax in axs[n:]:
+        ax.set_visible(False)
+    fig.suptitle(title, fontsize="small")
+    return fig
+
+
+def deformed_field_figure(X, Y, u, mag: float, title: str):
+    """Two panels: the x and y components of a displacement field ``u`` (n, n, 2) on the
+    grid (X, Y), drawn on the grid deformed by ``mag`` u, with every (n - 1) // 20-th
+    grid line and a colour bar as high as the axes (ticks with the power on top)."""
+    fig, axs = new_figure((10.0, 4.6), 1, 2, gridspec_kw=dict(wspace=0.3))
+    Xd, Yd = X + mag * u[..., 0], Y + mag * u[..., 1]
+    for ax, c, name in zip(axs, (0, 1), ("x-component", "y-component")):
+        m = ax.pcolormesh(Xd, Yd, u[..., c], shading="gouraud", cmap="jet")
+        step = max(1, (X.shape[0] - 1) // 20)
+        for i in range(0, X.shape[0], step):
+            ax.plot(Xd[i, :], Yd[i, :], "k-", lw=0.3)
+            ax.plot(Xd[:, i], Yd[:, i], "k-", lw=0.3)
+        cax = make_axes_locatable(ax).append_axes("right", size="4%", pad=0.08)
+        cb = fig.colorbar(m, cax=cax)
+        cb.formatter.set_powerlimits((0, 0))
+        cb.update_ticks()
+        ax.set_aspect("equal")
+        ax.set_xlim(Xd.min(), Xd.max())
+        ax.set_ylim(Yd.min(), Yd.max())
+        ax.set_title(f"{name}: {u[..., c].min():.4e} .. {u[..., c].max():.4e}",
+                     fontsize="small")
+    fig.suptitle(title + f" (grid deformed x{mag:g})", fontsize="small")
+    return fig

@@ -6,6 +6,9 @@ figure it produces); :func:`write_result` turns each into
     <out>/<name>.csv    the table (published columns first, then dof, wall_time_s, ...)
     <out>/<name>.json   claims, notes, meta, keys, tolerances, published file, provenance
     <out>/<name>.png    the figure, if there is one
+    <out>/vtu/<name>_<key>.vtu   its ParaView exports (``exports``), one per key; a key
+                        exporting several load steps gives <name>_<key>_<k>.vtu, k = 0,
+                        1, ..., and the collection <name>_<key>.pvd that plays them
 
 Every file is written atomically (temporary file in the same directory, fsync,
 ``os.replace``): an interrupted run never leaves a half-written file under the final
@@ -55,6 +58,7 @@ __all__ = [
     "provenance",
     "artefact_kind",
     "TOLERANCE_KINDS",
+    "VTU_DIR",
 ]
 
 #: tolerance kinds: ("factor", f) - reproduced/published within [1/f, f];
@@ -70,19 +74,35 @@ PROVENANCE_PACKAGES = ("numpy", "scipy", "numba", "scikit-fem", "pandas", "matpl
 class ArtefactResult:
     """One thesis artefact (table or figure) as reproduced.
 
-    name : artefact id as in EXPERIMENTS.md, e.g. "table_2_1"
-    table : published columns first (same names as report/published/<file>.csv),
-        then dof, wall_time_s, ...
-    figure : matplotlib figure (required for ``figure_*`` artefacts)
-    published : file name in report/published/, e.g. "table_2_1_nitsche_smooth_h_BE.csv"
-    keys : columns joining the reproduced with the published table
-    tolerances : column -> ("factor", 2.0) or ("abs", 0.15)
-    claims : the thesis's statements, checked
-    notes : choices and explanations shown in the report
-    meta : timings (jit_s, run_s), dof, iterations, ...; ``allow_nan_columns`` lists
+    Parameters
+    ----------
+    name : str
+        the artefact id as in EXPERIMENTS.md, e.g. "table_2_1"
+    table : pandas.DataFrame
+        the published columns first (same names as report/published/<file>.csv), then
+        dof, wall_time_s, ...
+    figure : matplotlib.figure.Figure, optional
+        required for ``figure_*`` artefacts
+    published : str, optional
+        the file name in report/published/, e.g. "table_2_1_nitsche_smooth_h_BE.csv"
+    keys : tuple of str
+        the columns joining the reproduced with the published table
+    tolerances : dict
+        column -> ("factor", 2.0) or ("abs", 0.15)
+    claims : list of Claim
+        the thesis's statements, checked
+    notes : str
+        choices and explanations shown in the report
+    meta : dict
+        timings (jit_s, run_s), dof, iterations, ...; ``allow_nan_columns`` lists the
         float columns that may contain NaN (e.g. the first rate of a sweep)
-    exports : {key: meshio.Mesh} meshes with fields for ParaView, written as
-        ``<out>/<name>_<key>.vtu`` (see :mod:`hpfebe.io.vtu`)
+    exports : dict
+        {key: meshio.Mesh or [(time, meshio.Mesh), ...]}: meshes with fields for
+        ParaView (built with :mod:`hpfebe.io.vtu`), ``key`` an identifier.  One mesh is
+        written as ``<out>/vtu/<name>_<key>.vtu``; a list of (load step or time, mesh)
+        pairs, times increasing, as ``<out>/vtu/<name>_<key>_<k>.vtu`` (k = 0, 1, ...)
+        with the ParaView collection ``<out>/vtu/<name>_<key>.pvd``
+        (:func:`hpfebe.io.write_vtu_series`)
     """
 
     name: str
@@ -296,18 +316,69 @@ def validate(result: ArtefactResult) -> None:
                 "columns listed in meta['allow_nan_columns'] and explained in notes")
     if name.startswith("figure_") and result.figure is None:
         raise ValueError(f"{name}: figure artefacts must return a figure")
+    _validate_exports(name, result.exports)
+
+
+def _validate_exports(name: str, exports) -> None:
+    """``exports`` = {identifier: meshio.Mesh or non-empty [(time, meshio.Mesh), ...]
+    with finite, strictly increasing times}; ValueError naming the key otherwise."""
+    if not isinstance(exports, dict):
+        raise ValueError(f"{name}: exports must be a dict {{key: meshio.Mesh}}, got "
+                         f"{type(exports).__name__}")
+    if not exports:
+        return
+    import meshio
+
+    for key, value in exports.items():
+        if not isinstance(key, str) or not key.isidentifier():
+            raise ValueError(f"{name}: exports key {key!r} must be an identifier "
+                             "(it is part of a file name)")
+        if isinstance(value, meshio.Mesh):
+            continue
+        steps = list(value) if isinstance(value, (list, tuple)) else None
+        if not steps or not all(isinstance(s, (list, tuple)) and len(s) == 2
+                                and isinstance(s[1], meshio.Mesh) for s in steps):
+            raise ValueError(f"{name}: exports[{key!r}] must be a meshio.Mesh or a non-empty "
+                             "list of (time, meshio.Mesh) pairs (a load-step series), got "
+                             f"{type(value).__name__}")
+        times = [s[0] for s in steps]
+        if not all(isinstance(t, (int, float, np.integer, np.floating))
+                   and not isinstance(t, (bool, np.bool_)) and math.isfinite(t)
+                   for t in times) or np.any(np.diff(np.asarray(times, float)) <= 0):
+            raise ValueError(f"{name}: exports[{key!r}]: the times of a series must be "
+                             f"finite numbers, strictly increasing, got {times!r}")
 
 
 # --------------------------------------------------------------------------- writing
 def write_result(result: ArtefactResult, out_dir: Path | str, config: dict | None = None,
                  *, run_info: dict | None = None) -> list[Path]:
-    """Write ``<out>/<name>.csv``, ``.png`` (if there is a figure) and ``.json``
-    (last), each atomically.  Returns the paths written.
+    """Write a result into ``out_dir``, every file atomically.
 
-    Raises ValueError (naming the column) if a float column has NaN that is not in
-    ``result.meta['allow_nan_columns']``, and for any other breach of the contract.
-    ``run_info`` (quick flag, config files, wall time of the run) goes into the
-    provenance."""
+    Parameters
+    ----------
+    result : ArtefactResult
+        validated first (:func:`validate`)
+    out_dir : str or Path
+        the results folder
+    config : dict, optional
+        the config used (into the provenance)
+    run_info : dict, optional
+        quick flag, config files, wall time of the run (into the provenance)
+
+    Returns
+    -------
+    list of Path
+        the files written, in order: ``<out>/<name>.csv``, ``<name>.png`` (if there is
+        a figure), the exports (``<out>/vtu/<name>_<key>.vtu``, and for a series its
+        VTU files and ``.pvd``), and ``<name>.json`` last (a result is complete when
+        its JSON exists).
+
+    Raises
+    ------
+    ValueError
+        naming the column, if a float column has NaN that is not in
+        ``result.meta['allow_nan_columns']``, and for any other breach of the contract.
+    """
     validate(result)
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
@@ -330,17 +401,8 @@ def write_result(result: ArtefactResult, out_dir: Path | str, config: dict | Non
     elif png.exists():  # a stale figure from an earlier run would be mistaken as current
         png.unlink()
 
-    exports = []
-    if result.exports:
-        from ..io.vtu import write_vtu
-        from .watch import before_rename
-
-        for key, mesh in result.exports.items():
-            if not str(key).isidentifier():
-                raise ValueError(f"exports key {key!r} must be an identifier (file name part)")
-            written.append(write_vtu(out / f"{result.name}_{key}.vtu", mesh,
-                                     before_rename=before_rename))
-            exports.append(written[-1].name)
+    exports = _write_exports(result, out)
+    written += exports
 
     doc = {
         "name": result.name,
@@ -357,12 +419,39 @@ def write_result(result: ArtefactResult, out_dir: Path | str, config: dict | Non
         "n_rows": int(len(table)),
         "has_figure": result.figure is not None,
         "files": files,
-        "exports": exports,
+        "exports": [p.relative_to(out).as_posix() for p in exports],
         "provenance": provenance(config, run_info),
     }
     text = json.dumps(_jsonable(doc), indent=2, allow_nan=False) + "\n"
     written.append(atomic_write(out / f"{result.name}.json", lambda f: f.write(text)))
     return written
+
+
+#: the folder of ``results/`` that holds the ParaView exports
+VTU_DIR = "vtu"
+
+
+def _write_exports(result: ArtefactResult, out: Path) -> list[Path]:
+    """The exports of ``result`` written into ``<out>/vtu/`` (atomically, the job watch
+    asked before every rename): ``<name>_<key>.vtu`` for one mesh, the VTU files of a
+    series and its ``.pvd`` collection (last) for a list of (time, mesh)."""
+    if not result.exports:
+        return []
+    import meshio
+
+    from ..io.vtu import write_vtu, write_vtu_series
+    from .watch import before_rename
+
+    folder = out / VTU_DIR
+    paths: list[Path] = []
+    for key, value in result.exports.items():
+        stem = f"{result.name}_{key}"
+        if isinstance(value, meshio.Mesh):
+            paths.append(write_vtu(folder / f"{stem}.vtu", value, before_rename=before_rename))
+        else:
+            paths += write_vtu_series(folder / f"{stem}.pvd", value,
+                                      before_rename=before_rename)
+    return paths
 
 
 def artefact_kind(name: str) -> str:

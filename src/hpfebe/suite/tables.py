@@ -3,6 +3,7 @@ frames, observed rates per group of a sweep.
 
     pub = published_table("table_3_1_penalty_eps.csv")
     df["rate"] = grouped_rates(df, ["C_pen", "p"], "h", "energy_error")
+    ratio = published_ratio(table, pub, ["C_eps", "dof"], "err")   # ours / published
 """
 
 from __future__ import annotations
@@ -14,7 +15,7 @@ import pandas as pd
 
 from hpfebe.analysis import observed_rates
 
-__all__ = ["published_table", "grouped_rates", "PUBLISHED_DIR"]
+__all__ = ["published_table", "grouped_rates", "published_ratio", "PUBLISHED_DIR"]
 
 #: report/published/ of the repository (the package is installed from its src/)
 PUBLISHED_DIR = Path(__file__).resolve().parents[3] / "report" / "published"
@@ -40,3 +41,12 @@ def grouped_rates(df: pd.DataFrame, by, h, e) -> np.ndarray:
     for rows in df.groupby(by, sort=False).indices.values():
         out[rows] = observed_rates(h[rows], e[rows])
     return out
+
+
+def published_ratio(table: pd.DataFrame, published: pd.DataFrame, keys, col: str,
+                    ours: str | None = None) -> pd.Series:
+    """reproduced / published of column ``col`` over the rows present in both tables
+    (joined on the columns ``keys``); ``ours``: the column of ``table`` to divide (default
+    ``col``)."""
+    m = table.merge(published, on=list(keys), suffixes=("", "_pub"))
+    return m[ours or col] / m[f"{col}_pub"]

@@ -1,7 +1,7 @@
 """Compile the numba kernels once, before the experiments need them (``hpfebe compile``).
 
 numba compiles a kernel at its first call and keeps the machine code in its on-disk cache
-(``__pycache__`` beside the sources, or ``NUMBA_CACHE_DIR``).  On a fresh machine the
+(one directory per digest of the kernel sources: :mod:`hpfebe._numba_cache`).  On a fresh machine the
 experiments of a ``snakemake -j2`` run would each compile the same kernels at once (two
 jobs, the same ~30 s twice); the workflow's ``numba_cache`` rule runs :func:`compile_kernels`
 first instead, and only the modules that call numba wait for it.
@@ -70,7 +70,7 @@ def _bem(steps: dict) -> None:
 
 
 def _contact(steps: dict) -> None:
-    from ..scenes.mortar import model_problem
+    from ..scenes.mortar import ModelProblem, model_problem
     from ..solvers import UzawaSettings, projected_cg
 
     t = time.perf_counter()
@@ -79,7 +79,7 @@ def _contact(steps: dict) -> None:
     steps["projected_cg"] = time.perf_counter() - t
 
     t = time.perf_counter()
-    mc = model_problem(n1=2, n2=2, p1=1, p2=1)
+    mc = model_problem(ModelProblem(n1=2, n2=2, p1=1, p2=1))
     mc.uzawa(np.zeros(2 * len(mc.points)), UzawaSettings(max_iter=2, relative=False))
     steps["uzawa"] = time.perf_counter() - t
 

@@ -3,9 +3,10 @@
 The registry reads ``ARTEFACTS`` from every ``experiments/*.py`` *without importing the
 modules* (``ast``): the Snakefile builds its rules from it in milliseconds, and a module
 that fails to import (work in progress, missing dependency) still gets its rule and fails
-only when it runs.  Standard library only.
+only when it runs.  Standard library only (the Snakefile imports it from the checkout's
+``src/`` before anything else of hpfebe).
 
-A file is an experiment module if it is not private (``_*.py``), is not this file, and
+A file is an experiment module if it is not private (``_*.py``) and
 assigns a tuple of string literals to ``ARTEFACTS`` at module level.  An experiment may
 also be a package, ``experiments/<name>/__init__.py`` (scene, claims and figures in
 modules beside it): its ``__init__.py`` holds ``ARTEFACTS``, ``SCENES`` and ``run``.  Other files
@@ -32,13 +33,11 @@ import re
 from dataclasses import dataclass
 from pathlib import Path
 
-__all__ = ["Experiment", "Job", "Registry", "discover", "unknown_sections", "EXPERIMENTS_DIR", "RESERVED",
+__all__ = ["Experiment", "Job", "Registry", "discover", "unknown_sections", "RESERVED",
            "SCENE_SEP"]
 
-EXPERIMENTS_DIR = Path(__file__).resolve().parent
-
 #: names that cannot be module names (they are Snakemake rules of their own)
-RESERVED = frozenset({"all", "report", "registry"})
+RESERVED = frozenset({"all", "report", "numba_cache"})
 
 _ARTEFACT_RE = re.compile(r"^[a-z][a-z0-9_]*$")
 _SCENE_RE = re.compile(r"^[a-z][a-z0-9]*(_[a-z0-9]+)*$")
@@ -273,11 +272,11 @@ def unknown_sections(config: dict, modules) -> list[tuple[str, str | None]]:
     return out
 
 
-def discover(directory: Path | str | None = None) -> Registry:
-    """All experiment modules in ``directory`` (default: this package), sorted by name.
-    Raises ValueError if two modules claim the same artefact or a module name is
-    reserved."""
-    directory = Path(directory) if directory is not None else EXPERIMENTS_DIR
+def discover(directory: Path | str) -> Registry:
+    """All experiment modules in ``directory`` (the checkout's ``experiments/``), sorted
+    by name.  Raises ValueError if two modules claim the same artefact or a module name
+    is reserved."""
+    directory = Path(directory)
     if not directory.is_dir():
         raise FileNotFoundError(f"experiments directory not found: {directory}")
     found: list[Experiment] = []
@@ -286,7 +285,7 @@ def discover(directory: Path | str | None = None) -> Registry:
     for path in sorted(candidates, key=lambda p: (p.parent.name if p.name == "__init__.py"
                                                  else p.stem)):
         name = path.parent.name if path.name == "__init__.py" else path.stem
-        if name.startswith("_") or name == "registry":
+        if name.startswith("_"):
             continue
         assigned = _assignments(path)
         arts = _artefacts_of(path, assigned)

@@ -1,0 +1,75 @@
+"""numba's on-disk cache, keyed on the sources of every kernel.
+
+numba keys a cached function on the contents of its own file only: a kernel that calls a
+jitted function of another file (the BEM assembly calls :mod:`hpfebe.bem.integration` and
+:mod:`hpfebe.bem.kernels`; the mortar Uzawa kernel calls
+:func:`hpfebe.constitutive.laws.tresca_return`) keeps the machine code of the callee it
+was compiled with, and after an edit of the callee the old code runs, silently.  So
+:func:`configure` points numba's cache at a directory named by a digest of every source
+file of the package that uses numba: an edit of any of them gives a fresh cache (the
+kernels compile once more, about a minute of CPU), an unchanged tree finds its own.
+
+The directory is ``<root>/hpfebe-<digest>``, with ``<root>`` the ``NUMBA_CACHE_DIR`` the
+user set, else ``$XDG_CACHE_HOME/hpfebe/numba`` (``~/.cache/hpfebe/numba``).  Every
+process of one source tree (the workflow's jobs, the tests) computes the same name, so
+``hpfebe compile`` readies the kernels for all of them, and keeps the three digest
+directories it readied last (:func:`remove_stale`).
+"""
+
+from __future__ import annotations
+
+import hashlib
+import os
+import shutil
+import sys
+from pathlib import Path
+
+PACKAGE = Path(__file__).resolve().parent
+#: the environment variable numba reads (before numba is imported)
+ENV = "NUMBA_CACHE_DIR"
+PREFIX = "hpfebe-"
+
+
+def sources_digest(package: Path = PACKAGE) -> str:
+    """A digest of the package's files that use numba (path and content), 16 hex digits."""
+    h = hashlib.blake2b(digest_size=8)
+    for path in sorted(package.rglob("*.py")):
+        data = path.read_bytes()
+        if b"numba" in data:
+            h.update(str(path.relative_to(package)).encode() + b"\0" + data + b"\0")
+    return h.hexdigest()
+
+
+def cache_root() -> Path:
+    """Where the digest directories live: the ``NUMBA_CACHE_DIR`` the user set (or its
+    parent, when it is already a digest directory: a child process of an hpfebe process
+    inherits that), else ``$XDG_CACHE_HOME/hpfebe/numba``."""
+    user = os.environ.get(ENV)
+    if user:
+        user = Path(user)
+        return user.parent if user.name.startswith(PREFIX) else user
+    base = os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache"
+    return Path(base) / "hpfebe" / "numba"
+
+
+def configure() -> Path:
+    """Point numba's cache at this source tree's directory and return it.  Called by
+    ``import hpfebe``, before any kernel is defined."""
+    cache = cache_root() / f"{PREFIX}{sources_digest()}"
+    os.environ[ENV] = str(cache)
+    if "numba" in sys.modules:           # numba imported before hpfebe: tell its config
+        sys.modules["numba"].config.CACHE_DIR = str(cache)
+    return cache
+
+
+def remove_stale(keep: int = 3) -> list[Path]:
+    """Remove the digest directories of the cache root but the ``keep`` most recently
+    readied ones (``hpfebe compile`` touches the current one); returns them."""
+    root = cache_root()
+    dirs = sorted((d for d in root.glob(f"{PREFIX}*") if d.is_dir()),
+                  key=lambda d: d.stat().st_mtime, reverse=True) if root.is_dir() else []
+    current = Path(os.environ.get(ENV, ""))
+    stale = [d for d in dirs[keep:] if d != current]
+    for d in stale:
+        shutil.rmtree(d, ignore_errors=True)
+    return stale

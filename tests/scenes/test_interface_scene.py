@@ -1,0 +1,70 @@
+"""The Chapter 2 scene's tables (hpfebe.scenes.interface): the published-format part
+tables with their observed rates, the work-precision timings, the solution fields."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from hpfebe.scenes import interface
+
+
+def _sweep():
+    """A synthetic sweep: series h at p = 1, 2 (e = h^(p+1), h^p), series p on one mesh
+    (e = 2^-p), rows deliberately out of order."""
+    rows = []
+    for p in (2, 1):
+        for fh in (8, 2, 4):
+            rows.append(dict(series="h", p=p, fe_h_inv=fh, be_h_inv=fh + 1, dof=10 * fh,
+                             fe_l2=fh ** -(p + 1.0), fe_h1=fh ** -float(p),
+                             be_l2=2.0 * fh ** -(p + 1.0), be_h1=3.0 * fh ** -float(p),
+                             be_energy=fh ** -1.5, be_h1_interp=fh ** -1.0,
+                             wall_time_s=0.1, lambda_nit=10.0))
+    for p in (1, 3, 2):
+        rows.append(dict(series="p", p=p, fe_h_inv=4, be_h_inv=6, dof=50 * p,
+                         fe_l2=2.0 ** -p, fe_h1=2.0 ** -p, be_l2=2.0 ** -p, be_h1=2.0 ** -p,
+                         be_energy=2.0 ** -p, be_h1_interp=2.0 ** -p, wall_time_s=0.1,
+                         lambda_nit=10.0))
+    return {k: [r[k] for r in rows] for k in rows[0]}
+
+
+def test_part_table_sorts_groups_and_measures_rates():
+    t = interface.part_table(_sweep(), "fe", "fe_h_inv")
+    # groups in the order of the sweep (h: p = 2 then 1; then p), sorted within
+    assert list(t["series"]) == ["h"] * 6 + ["p"] * 3
+    assert list(t["p"]) == [2, 2, 2, 1, 1, 1, 1, 2, 3]
+    assert list(t["h_inv"][:3]) == [2, 4, 8] and t["h_inv"].dtype.kind == "i"
+    r = t["l2_rate"]
+    assert np.isnan(r[0]) and np.isnan(r[3]) and np.isnan(r[6])
+    assert np.allclose(r[[1, 2]], 3.0) and np.allclose(r[[4, 5]], 2.0)
+    assert np.allclose(t["h1_rate"][[1, 2, 4, 5]], [2, 2, 1, 1])
+    # series p: rates w.r.t. p of e = 2^-p: log(2) / log(p / p_prev)
+    assert np.allclose(r[7:], [np.log(2) / np.log(2), np.log(2) / np.log(1.5)])
+    assert "trace_energy_error" not in t
+
+
+def test_part_table_be_adds_the_trace_energy_columns():
+    t = interface.part_table(_sweep(), "be", "be_h_inv")
+    assert list(t["h_inv"][:3]) == [3, 5, 9]
+    assert np.allclose(t["trace_energy_error"][:3], np.array([2, 4, 8]) ** -1.5)
+    assert np.isnan(t["trace_energy_rate"][0])
+    assert np.allclose(t["h1_error"][:3], 3.0 * np.array([2, 4, 8]) ** -2.0)
+
+
+def test_work_precision_rows_take_the_minimum_of_the_repeats():
+    prm = interface.ConvergenceScene(timing_repeats=2)
+    rows = [dict(problem="smooth", series="h", p=1, fe_h_inv=2, be_h_inv=3,
+                 assembly_s=1e3, solve_s=1e3, wall_time_s=2e3, fe_h1=0.1)]
+    out = interface.work_precision_rows(prm, rows)
+    assert out[0]["fe_h1"] == 0.1
+    assert out[0]["assembly_s"] < 1e3 and out[0]["solve_s"] < 1e3
+    assert out[0]["wall_time_s"] < out[0]["wall_time_max_s"] == 2e3
+
+
+def test_solution_fields_meet_the_exact_solution():
+    model, sol, d2, vals = interface.solution_fields("smooth", 5, 6, 10.0)
+    x, y = d2.p
+    assert vals.shape == (d2.p.shape[1],)
+    assert np.max(np.abs(vals - interface.problem("smooth").u(x, y))) < 0.02
+    with pytest.raises(ValueError, match="problem"):
+        interface.solution_fields("smoth", 5, 6, 10.0)
