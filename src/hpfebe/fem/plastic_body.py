@@ -378,10 +378,15 @@ class ElastoPlasticFE:
 
     def fields(self) -> dict:
         """Committed fields per quadrature point, (nel, nq): ||eps_p||, ||dev sigma||,
-        alpha, and the element means (nel,) under the keys ``*_mean``."""
+        alpha (the hardening variable), the stress and plastic strain components
+        ``sigma_xx`` ... ``eps_p_xy`` (xx, yy, zz, xy), and the element means (nel,)
+        under the keys ``*_mean``."""
         out = {"eps_p_norm": tensor_norm(self.committed.eps_p),
                "dev_sigma_norm": tensor_norm(dev(self.sigma)),
                "alpha": self.committed.alpha}
+        for name, t in (("sigma", self.sigma), ("eps_p", self.committed.eps_p)):
+            for c, (i, j) in zip(("xx", "yy", "zz", "xy"), ((0, 0), (1, 1), (2, 2), (0, 1))):
+                out[f"{name}_{c}"] = t[..., i, j]
         w = self.dx / self.dx.sum(axis=1, keepdims=True)
         for k in list(out):
             v = out[k].reshape(self.nel, self.nq)
