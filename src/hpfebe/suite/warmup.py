@@ -96,6 +96,15 @@ def _plastic(steps: dict) -> None:
     steps["plasticity"] = time.perf_counter() - t
 
 
+def _hmatrix(steps: dict) -> None:
+    from ..scenes import bem_scaling as bs
+
+    t = time.perf_counter()
+    for pde, p in (("laplace", 1), ("laplace", 4), ("lame", 1), ("lame", 2)):
+        bs.solve(bs.ScalingRun(pde, 16, p, "hmatrix"))   # figure_bem_scaling's cases
+    steps["hmatrix"] = time.perf_counter() - t
+
+
 def compile_kernels() -> dict[str, float]:
     """Run the tiny scenes; returns the wall time [s] of each (compile time on a cold
     cache, loading time on a warm one)."""
@@ -103,4 +112,5 @@ def compile_kernels() -> dict[str, float]:
     _bem(steps)
     _contact(steps)
     _plastic(steps)
+    _hmatrix(steps)
     return steps
