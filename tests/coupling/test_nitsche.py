@@ -280,16 +280,19 @@ def test_solve_returns_solver_info():
     assert sol.solver.residuals[-1] == sol.info["residual"] <= 1e-10
 
 
-def test_schur_lu_symmetric_mode_and_fallback():
-    """The SPD LU of the coercivity Schur complements (minimum degree on A + A^T, diagonal
-    pivots) solves SPD systems, and falls back to partial pivoting on a zero pivot."""
-    import scipy.sparse as sp
+def test_nitsche_lu_is_symmetric_mode_and_equals_partial_pivoting():
+    """The coupled system is factorised by SuperLU in symmetric mode (reported), and its
+    solution equals the one of the default LU (COLAMD, partial pivoting) to round-off,
+    for lambda_nit above and below the coercivity threshold."""
+    import scipy.sparse.linalg as spla
 
-    from hpfebe.coupling.coercivity import _spd_lu
-
-    A = sp.random(30, 30, 0.2, random_state=1)
-    A = (A @ A.T + sp.eye(30)).tocsc()
-    b = np.arange(30.0)
-    np.testing.assert_allclose(A @ _spd_lu(A).solve(b), b, atol=1e-12 * np.abs(b).max())
-    swap = sp.csc_matrix(np.array([[0.0, 1.0], [1.0, 0.0]]))
-    np.testing.assert_allclose(_spd_lu(swap).solve(np.array([1.0, 2.0])), [2.0, 1.0])
+    model = NitscheFEBE(SMOOTH, 4, 6, 3)
+    for lam in (10.0, 0.5):
+        sol = model.solve(lam)
+        assert sol.info["lu"] in ("symmetric", "partial pivoting")
+        assert sol.info["lu"] in sol.solver.reason
+        M = model.matrix(lam).tocsc()
+        x = spla.splu(M).solve(np.concatenate([model.b1, model.b2]))
+        U = np.concatenate([sol.U1[model.free1], sol.U2[model.free2]])
+        assert np.linalg.norm(U - x) <= 1e-10 * np.linalg.norm(x)
+    assert model.solve(10.0).info["lu"] == "symmetric"

@@ -33,7 +33,8 @@ record the comparison).  alpha = 2, the choice that makes the bound of Lemma 2.2
 p-independent, is available as a parameter.
 
 Solver (``solve``): the FE block is large and sparse, S_hat is small and dense.  The whole
-system is factorised once per lambda by a sparse LU with the n2 x n2 BE block stored as a
+system is factorised once per lambda by a sparse LU (SuperLU in symmetric mode,
+:mod:`hpfebe.solvers.sparse_lu`) with the n2 x n2 BE block stored as a
 dense block inside the sparse matrix: the FE block is never densified, and the fill the
 dense block causes stays within its n2 rows and columns (static condensation onto the BE
 dofs would need one FE solve per coupled BE dof).  The relative residual of the full
@@ -49,7 +50,6 @@ from typing import Callable
 
 import numpy as np
 import scipy.sparse as sp
-import scipy.sparse.linalg as spla
 
 from ..bem import LaplaceBEM
 from ..fem.meshes import FEDomain, tensor_block_mesh
@@ -57,6 +57,7 @@ from ..fem.poisson import PoissonFE
 from ..geometry import BoundaryMesh
 from ..quadrature import gauss_legendre
 from ..solvers import SolverInfo
+from ..solvers.sparse_lu import solve_checked
 from .interface import interface_rule
 
 log = logging.getLogger(__name__)
@@ -290,11 +291,11 @@ class NitscheFEBE:
         K11, K12, K22 = blocks = self.blocks(lambda_nit)
         K21 = K12.T.tocsr()
         try:
-            lu = spla.splu(self.matrix(lambda_nit, blocks).tocsc())
+            x, _, lu_kind = solve_checked(self.matrix(lambda_nit, blocks),
+                                          np.concatenate([self.b1, self.b2]))
         except RuntimeError as exc:
             raise np.linalg.LinAlgError(f"coupled system singular for lambda_Nit="
                                         f"{lambda_nit}: {exc}") from exc
-        x = lu.solve(np.concatenate([self.b1, self.b2]))
         U1, U2 = x[:self.n1], x[self.n1:]
         r1 = K11 @ U1 + K12 @ U2 - self.b1
         r2 = K21 @ U1 + K22 @ U2 - self.b2
@@ -311,6 +312,7 @@ class NitscheFEBE:
         full2[self.free2] = U2
         info = {"residual": res, "solve_s": time.perf_counter() - t0, "n_fe": self.n1,
                 "n_be": self.n2, **self.timings}
-        solver = SolverInfo(True, "converged (sparse LU, relative residual checked)", 1,
-                            [1.0, res])
+        info["lu"] = lu_kind
+        solver = SolverInfo(True, f"converged (sparse LU, {lu_kind}; relative residual "
+                            "checked)", 1, [1.0, res])
         return NitscheSolution(float(lambda_nit), full1, full2, info, solver)
