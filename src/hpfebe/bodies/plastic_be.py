@@ -94,6 +94,42 @@ def _times_blocks_kernel(A, D):
     return out
 
 
+@numba.njit(cache=True)
+def _plastic_blocks_kernel(M, pl, D):
+    """(MD, J) of the plastic cells ``pl``: MD = M[:, p] blockdiag(D[pl]) (p the strain
+    rows 3 pl + a) and J = I - MD[p], read straight from M and D (no column copies of
+    M); every entry of MD is the 3-term sum of :func:`_times_blocks_kernel` in its
+    order, J is 1 - MD on its diagonal and 0 - MD elsewhere - the numbers of
+    ``np.eye(n) - MD[p]`` bit for bit."""
+    m, n = M.shape[0], pl.size
+    MD = np.empty((m, 3 * n))
+    for r in range(m):
+        for j in range(n):
+            c3 = 3 * pl[j]
+            for col in range(3):
+                acc = 0.0
+                for k in range(3):
+                    acc += M[r, c3 + k] * D[pl[j], k, col]
+                MD[r, 3 * j + col] = acc
+    J = np.empty((3 * n, 3 * n))
+    for a in range(n):
+        for i in range(3):
+            row = 3 * pl[a] + i
+            for q in range(3 * n):
+                J[3 * a + i, q] = 0.0 - MD[row, q]
+            J[3 * a + i, 3 * a + i] = 1.0 - MD[row, 3 * a + i]
+    return MD, J
+
+
+def _plastic_blocks(M: np.ndarray, pl: np.ndarray, D: np.ndarray):
+    """(MD, J) of :func:`_plastic_blocks_kernel`: the columns of M D on the plastic cells
+    ``pl`` and the reduced Jacobian I - M_pp D_p of (the step of)
+    :meth:`ElastoPlasticBE.implicit_response`."""
+    return _plastic_blocks_kernel(np.ascontiguousarray(M, dtype=float),
+                                  np.ascontiguousarray(pl, dtype=np.int64),
+                                  np.ascontiguousarray(D, dtype=float))
+
+
 class ElastoPlasticBE(CellStrainOperators):
     """J2 elastoplastic BE body.  ``bem``: :class:`~hpfebe.bem.LameBEM` of degree 1 (plane strain),
     ``cells``: :class:`CellComplex` covering the region where plastic strain may appear
@@ -196,6 +232,16 @@ class ElastoPlasticBE(CellStrainOperators):
         tau, _, KT = self.implicit_response(u)
         return self.S @ u - self.G @ tau, sp.csr_matrix(KT)
 
+    def internal_force_lazy(self, u: np.ndarray):
+        """(f_int(u), a callable returning the tangent at u, CSR as
+        :meth:`internal_force`); ``scheme="implicit"``: K_T computed only when called
+        (:meth:`implicit_response_lazy`)."""
+        u = np.asarray(u, dtype=float)
+        if self.scheme == "explicit":
+            return self.S @ u - self.plastic_force(), lambda: self.K
+        tau, _, tangent = self.implicit_response_lazy(u)
+        return self.S @ u - self.G @ tau, lambda: sp.csr_matrix(tangent())
+
     def _sym_rows(self, X: np.ndarray) -> np.ndarray:
         """Displacement-gradient rows (4 c + 2 i + m) of X -> strain rows (3 c + a),
         a: (eps11, eps22, 2 eps12)."""
@@ -221,7 +267,19 @@ class ElastoPlasticBE(CellStrainOperators):
         linear prediction e_last + (de/du)(u - u_last) from the last solve (measured:
         inner iterations per call 10 -> ...).  Returns (tau, ReturnMap, tangent matrix
         K_T = S_hat - G_p D_p (I - M_pp D_p)^-1 B_p); a non-converged inner solve returns
-        NaN tau (the outer Newton then reports divergence and the load step is cut)."""
+        NaN tau (the outer Newton then reports divergence and the load step is cut).
+        The tangent only when asked for: :meth:`implicit_response_lazy`."""
+        tau, rm, tangent = self.implicit_response_lazy(u, tol, max_iter)
+        return tau, rm, tangent()
+
+    def implicit_response_lazy(self, u: np.ndarray, tol: float = 1e-10,
+                               max_iter: int = 50):
+        """(tau, ReturnMap, a callable returning K_T) of :meth:`implicit_response`: one LU
+        factorisation of I - M_pp D_p at the solution (scipy.linalg.lu_factor), used by
+        the tangent (computed on the callable's first call, not at rejected line-search
+        trials of the contact Newton) and by the next call's linear prediction
+        (de/du) v = B v + M_p D_p (I - M_pp D_p)^-1 B_p v, one right-hand side instead
+        of the columns of de/du (measured on the BE/BE runs of Example 2: ...)."""
         u = np.asarray(u, dtype=float)
         key = u.tobytes()
         if getattr(self, "_icache", None) is not None and self._icache[0] == key:
@@ -231,28 +289,45 @@ class ElastoPlasticBE(CellStrainOperators):
         starts = [B @ u + M @ self.tau(self.committed.eps_p).ravel()]
         last = getattr(self, "_ilast", None)
         if last is not None:
-            starts.append(last[1] + last[2] @ (u - last[0]))
+            starts.append(last[1] + self._strain_derivative_times(last, u - last[0]))
         it0 = min((prob.evaluate(e0) for e0 in starts), key=lambda i: i.merit)
         it, info = newton(prob, it0.x, tol=tol, max_iter=max_iter,
                           line_search=LineSearch(max_halvings=20))
         tau, rm, D, pl = it.data
         self.inner_info = info
-        dE = B
+        p3 = MD = lu = None
         if pl.size:
             p3 = (3 * pl[:, None] + np.arange(3)).ravel()
-            MD = _times_blocks(M[:, p3], D[pl])
-            X = np.linalg.solve(np.eye(p3.size) - MD[p3], B[p3])        # d e_p / d u
-            KT = self.S - _times_blocks(self.G[:, p3], D[pl]) @ X
-            dE = B + MD @ X                                              # d e / d u
-        else:
-            KT = self.S
+            MD, J = _plastic_blocks(M, pl, D)
+            lu = sla.lu_factor(J, overwrite_a=True, check_finite=False)
         if info.converged:
-            self._ilast = (u.copy(), it.x.copy(), dE)
+            self._ilast = (u.copy(), it.x.copy(), p3, MD, lu)
         else:
             tau = np.full_like(tau, np.nan)
-        out = (tau, rm, KT)
+        memo = []
+
+        def tangent() -> np.ndarray:
+            if not memo:
+                if p3 is None:
+                    memo.append(self.S)
+                else:
+                    X = sla.lu_solve(lu, B[p3], check_finite=False)     # d e_p / d u
+                    memo.append(self.S - _times_blocks(self.G[:, p3], D[pl]) @ X)
+            return memo[0]
+
+        out = (tau, rm, tangent)
         self._icache = (key, out)
         return out
+
+    def _strain_derivative_times(self, last, v: np.ndarray) -> np.ndarray:
+        """(de/du) v at the last solve ``last`` = (u, e, p3, MD, lu):
+        B v + MD (I - M_pp D_p)^-1 (B v)_p."""
+        _, B = self._strain_operators()
+        _, _, p3, MD, lu = last
+        Bv = B @ v
+        if p3 is None:
+            return Bv
+        return Bv + MD @ sla.lu_solve(lu, Bv[p3], check_finite=False)
 
     def update(self, u: np.ndarray, eps_p: np.ndarray | None = None):
         """Return map at the cell points from the committed state with the strain of
@@ -263,7 +338,7 @@ class ElastoPlasticBE(CellStrainOperators):
         """explicit: forward Euler update of the plastic strain from the committed
         state; implicit: the backward Euler state of :meth:`implicit_response`."""
         if self.scheme == "implicit":
-            _, rm, _ = self.implicit_response(u)
+            _, rm, _ = self.implicit_response_lazy(u)
         else:
             rm = self.update(u)
         self.committed, self.sigma, self.plastic = rm.state.copy(), rm.sigma, rm.plastic
@@ -298,6 +373,20 @@ class ElastoPlasticBE(CellStrainOperators):
                 "plastic": self.plastic.astype(float)}
 
 
+def _tau_strain_blocks(X: np.ndarray) -> np.ndarray:
+    """(n, 3, 3) blocks D_ab = sum TAU_SEL[a, i, j] X_ijkl EPS_SEL[b, k, l] of the 4th-order
+    tensors X (n, 3, 3, 3, 3), by indexing: rows (11, 22, 12), columns e = (eps11, eps22,
+    2 eps12) with 0.5 (X_..12 + X_..21) - the einsum over the selectors adds only
+    exact zeros to these terms, so the numbers are the same bit for bit."""
+    i, j = np.array([0, 1, 0]), np.array([0, 1, 1])
+    Y = X[:, i, j]                                               # (n, 3, 3, 3)
+    out = np.empty((len(X), 3, 3))
+    out[:, :, 0] = Y[:, :, 0, 0]
+    out[:, :, 1] = Y[:, :, 1, 1]
+    out[:, :, 2] = 0.5 * Y[:, :, 0, 1] + 0.5 * Y[:, :, 1, 0]
+    return out
+
+
 class _CellStrainProblem:
     """The inner problem of :meth:`ElastoPlasticBE.implicit_response` for
     :func:`hpfebe.solvers.newton`: x = cell strains e (3 ncell), residual
@@ -322,8 +411,7 @@ class _CellStrainProblem:
         pl = np.flatnonzero(rm.plastic)
         D = np.zeros((nc, 3, 3))
         if pl.size:
-            D[pl] = np.einsum("aij,cijkl,bkl->cab", _TAU_SEL,
-                              self.Cel[None] - rm.tangent[pl], _EPS_SEL)
+            D[pl] = _tau_strain_blocks(self.Cel[None] - rm.tangent[pl])
         F = e - self.b - self.M @ tau
         scale = float(np.abs(e).max(initial=0.0)) + self.eY
         return Iterate(e, F, 0.5 * float(F @ F), scale, key=rm.plastic.tobytes(),
@@ -335,9 +423,9 @@ class _CellStrainProblem:
         dx = -F
         if pl.size:
             p3 = (3 * pl[:, None] + np.arange(3)).ravel()
-            MD = _times_blocks(self.M[:, p3], D[pl])                 # M[:, p] D_p
+            MD, J = _plastic_blocks(self.M, pl, D)       # M[:, p] D_p, I - M_pp D_p
             try:
-                dp = np.linalg.solve(np.eye(p3.size) - MD[p3], -F[p3])
+                dp = np.linalg.solve(J, -F[p3])
             except np.linalg.LinAlgError as err:
                 raise SingularStep(f"cell strain Jacobian singular: {err}") from err
             dx = dx + MD @ dp
@@ -429,6 +517,16 @@ class PlasticBEBody(BEBody):
     def internal_force(self, u):
         f, T = self.plastic.internal_force(u)
         return f, (self.S if self.plastic.scheme == "explicit" else T.toarray())
+
+    def internal_force_lazy(self, u):
+        """(f_int, the dense tangent or a callable returning it): ``scheme="implicit"``:
+        K_T only when asked for (:meth:`ElastoPlasticBE.implicit_response_lazy`)."""
+        be = self.plastic
+        if be.scheme == "explicit":
+            return self.internal_force(u)
+        u = np.asarray(u, dtype=float)
+        tau, _, tangent = be.implicit_response_lazy(u)
+        return be.S @ u - be.G @ tau, tangent
 
     def commit(self, u) -> None:
         self.plastic.commit(u)
