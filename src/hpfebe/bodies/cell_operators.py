@@ -187,6 +187,22 @@ def match_nodes(points: np.ndarray, nodes: np.ndarray, tol: float) -> np.ndarray
     return np.where(d[np.arange(len(points)), j] <= tol, j, -1)
 
 
+SHARED = ("S", "K", "A_u", "A_tau", "G", "_PB")
+SHARED_MAX = 2
+_SHARED: list = []
+
+
+def _shared(bem, cells, E: float, nu: float) -> dict | None:
+    """The operators built before for the same ``bem`` and ``cells`` objects and elastic
+    constants (the BE/BE runs of one mesh for every theta, whose work pieces
+    :func:`hpfebe.bodies.plastic_be.rectangle_work_piece` gives the same bem and cells),
+    or None.  The last SHARED_MAX are kept, read-only."""
+    for b, c, e, n, ops in _SHARED:
+        if b is bem and c is cells and e == float(E) and n == float(nu):
+            return ops
+    return None
+
+
 class CellStrainOperators:
     """The operators of a BE body of degree 1 (``bem``, plane strain) with piecewise
     constant initial strain on ``cells`` (its nodes on Gamma coinciding with BEM nodes),
@@ -201,14 +217,27 @@ class CellStrainOperators:
             raise ValueError(f"bem must be plane strain (J2 body), got plane={bem.plane!r}")
         if not np.all(bem.mesh.degrees == 1):
             raise ValueError("bem must have degree 1 on every element (P1 displacements)")
-        check_cells(bem.mesh, cells)
+        shared = _shared(bem, cells, E, nu)
+        if shared is None:
+            check_cells(bem.mesh, cells)
         self.bem, self.cells = bem, cells
         self.E, self.nu = E, nu
         self.ndofs = 2 * bem.V_space.ndof
+        self.points = cells.centroids
+        if shared is not None:
+            for name, value in shared.items():
+                setattr(self, name, value)
+            return
         self.S = bem.S_hat
         self.K = sp.csr_matrix(self.S)
-        self.points = cells.centroids
         self._build()
+        ops = {name: getattr(self, name) for name in SHARED}
+        for name in ("A_u", "A_tau", "G"):
+            ops[name].setflags(write=False)
+        for X in ops["_PB"]:
+            X.setflags(write=False)
+        _SHARED.append((bem, cells, float(E), float(nu), ops))
+        del _SHARED[:-SHARED_MAX]
 
     def _P(self, Y: np.ndarray) -> np.ndarray:
         """Constrained V^{-1} (zero total force, as LameBEM.Psi) applied to columns Y."""
