@@ -169,7 +169,8 @@ def check_cells(mesh, cx: CellComplex) -> None:
         raise ValueError(f"cells must lie inside the body: the boundary element {k} "
                          f"({mesh.a[k].tolist()} to {mesh.b[k].tolist()}) cuts cell {c} "
                          f"(vertices {P[c].tolist()})")
-    i, j = _first_overlap(nodes, np.ascontiguousarray(cx.cells, dtype=np.int64),
+    i, j = _first_overlap(np.ascontiguousarray(nodes),      # one specialisation
+                          np.ascontiguousarray(cx.cells, dtype=np.int64),
                           np.ascontiguousarray(cx.centroids), tol)
     if i >= 0:
         raise ValueError(f"cells must not overlap: cells {i} (vertices {P[i].tolist()}) "
