@@ -385,6 +385,9 @@ def test_plastic_blocks_are_the_copies_they_replace():
     ref = _times_blocks(M[:, p3], D[pl])
     assert np.array_equal(MD, ref)
     assert np.array_equal(J, np.eye(p3.size) - ref[p3])
+    rows = np.setdiff1d(np.arange(3 * nc), p3)            # the elastic rows (a step)
+    MDe, Je = _plastic_blocks(M, pl, D, rows)
+    assert np.array_equal(MDe, ref[rows]) and np.array_equal(Je, J)
     assert not np.array_equal(J, np.eye(p3.size) - _times_blocks(M[:, p3], D[pl[::-1]])[p3])
     X = rng.standard_normal((11, 3, 3, 3, 3))          # not symmetric: every entry counts
     want = np.einsum("aij,cijkl,bkl->cab", _TAU_SEL, X, _EPS_SEL)

@@ -95,39 +95,48 @@ def _times_blocks_kernel(A, D):
 
 
 @numba.njit(cache=True)
-def _plastic_blocks_kernel(M, pl, D):
-    """(MD, J) of the plastic cells ``pl``: MD = M[:, p] blockdiag(D[pl]) (p the strain
-    rows 3 pl + a) and J = I - MD[p], read straight from M and D (no column copies of
-    M); every entry of MD is the 3-term sum of :func:`_times_blocks_kernel` in its
-    order, J is 1 - MD on its diagonal and 0 - MD elsewhere - the numbers of
+def _plastic_blocks_kernel(M, pl, D, rows):
+    """(MD, J) of the plastic cells ``pl``: MD = (M[:, p] blockdiag(D[pl]))[rows] (p the
+    strain rows 3 pl + a) and J = I - M[p, p] blockdiag(D[pl]), read straight from M and
+    D (no column copies of M); every entry is the 3-term sum of
+    :func:`_times_blocks_kernel` in its order, J is 1 - sum on its diagonal and 0 - sum
+    elsewhere - the numbers of ``MD = _times_blocks(M[:, p], D[pl])``,
     ``np.eye(n) - MD[p]`` bit for bit."""
-    m, n = M.shape[0], pl.size
-    MD = np.empty((m, 3 * n))
-    for r in range(m):
+    n = pl.size
+    MD = np.empty((rows.size, 3 * n))
+    for t in range(rows.size):
+        r = rows[t]
         for j in range(n):
             c3 = 3 * pl[j]
             for col in range(3):
                 acc = 0.0
                 for k in range(3):
                     acc += M[r, c3 + k] * D[pl[j], k, col]
-                MD[r, 3 * j + col] = acc
+                MD[t, 3 * j + col] = acc
     J = np.empty((3 * n, 3 * n))
     for a in range(n):
         for i in range(3):
-            row = 3 * pl[a] + i
-            for q in range(3 * n):
-                J[3 * a + i, q] = 0.0 - MD[row, q]
-            J[3 * a + i, 3 * a + i] = 1.0 - MD[row, 3 * a + i]
+            r = 3 * pl[a] + i
+            for j in range(n):
+                c3 = 3 * pl[j]
+                for col in range(3):
+                    acc = 0.0
+                    for k in range(3):
+                        acc += M[r, c3 + k] * D[pl[j], k, col]
+                    J[3 * a + i, 3 * j + col] = (1.0 if a == j and i == col else 0.0) - acc
     return MD, J
 
 
-def _plastic_blocks(M: np.ndarray, pl: np.ndarray, D: np.ndarray):
-    """(MD, J) of :func:`_plastic_blocks_kernel`: the columns of M D on the plastic cells
-    ``pl`` and the reduced Jacobian I - M_pp D_p of (the step of)
-    :meth:`ElastoPlasticBE.implicit_response`."""
+def _plastic_blocks(M: np.ndarray, pl: np.ndarray, D: np.ndarray, rows=None):
+    """(MD, J) of :func:`_plastic_blocks_kernel`: the rows ``rows`` (default all) of the
+    columns of M D on the plastic cells ``pl`` and the reduced Jacobian I - M_pp D_p of
+    :meth:`ElastoPlasticBE.implicit_response` (its Newton step needs the elastic rows of
+    MD only)."""
+    rows = np.arange(M.shape[0]) if rows is None else rows
     return _plastic_blocks_kernel(np.ascontiguousarray(M, dtype=float),
                                   np.ascontiguousarray(pl, dtype=np.int64),
-                                  np.ascontiguousarray(D, dtype=float))
+                                  np.ascontiguousarray(D, dtype=float),
+                                  np.ascontiguousarray(rows, dtype=np.int64))
 
 
 class ElastoPlasticBE(CellStrainOperators):
@@ -423,12 +432,15 @@ class _CellStrainProblem:
         dx = -F
         if pl.size:
             p3 = (3 * pl[:, None] + np.arange(3)).ravel()
-            MD, J = _plastic_blocks(self.M, pl, D)       # M[:, p] D_p, I - M_pp D_p
+            el = np.ones(F.size, dtype=bool)
+            el[p3] = False
+            el = np.flatnonzero(el)
+            MDe, J = _plastic_blocks(self.M, pl, D, el)   # M_ep D_p, I - M_pp D_p
             try:
                 dp = np.linalg.solve(J, -F[p3])
             except np.linalg.LinAlgError as err:
                 raise SingularStep(f"cell strain Jacobian singular: {err}") from err
-            dx = dx + MD @ dp
+            dx[el] += MDe @ dp                            # dx = -F: a new array
             dx[p3] = dp
         return dx
 
