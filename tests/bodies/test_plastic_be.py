@@ -466,3 +466,25 @@ def test_work_pieces_of_one_geometry_share_their_operators():
         assert np.array_equal(getattr(fresh, name), getattr(b, name))
     u = _plastic_punch(b)
     assert np.array_equal(b.internal_force(u)[0], fresh.internal_force(u)[0])
+
+
+def test_potential_matrix_is_the_columns_of_evaluate_potential():
+    """The double layer matrix of the cell operators (one pass over the point-element
+    pairs) equals the potential of every unit density evaluated column by column bit for
+    bit, near and far points (far tables, >= 32 points) alike; a point on Gamma is
+    refused."""
+    from hpfebe.bem.potentials import (POT_LAME_DL, PointOnBoundaryError,
+                                       evaluate_potential, potential_matrix)
+    bm = BoundaryMesh.polygon([(-1, 0), (1, 0), (1, 1), (-1, 1)], n=[8, 3, 8, 3])
+    bem = LameBEM(bm, MAT.E, MAT.nu)
+    rng = np.random.default_rng(5)
+    Y = np.vstack([np.column_stack([rng.uniform(-0.99, 0.99, 60), rng.uniform(0.01, 0.99, 60)]),
+                   [[0.0, 1e-4], [0.999, 0.5], [-0.3, 0.9999]]])
+    n = 2 * bem.V_space.ndof
+    cols = np.column_stack([evaluate_potential(POT_LAME_DL, bem.kp, 2, Y, bem.V_space,
+                                               np.eye(n)[k]).ravel() for k in range(n)])
+    A = potential_matrix(POT_LAME_DL, bem.kp, 2, Y, bem.V_space)
+    assert A.shape == (2 * len(Y), n) and np.abs(A).max() > 0
+    assert np.array_equal(A, cols)
+    with pytest.raises(PointOnBoundaryError, match="points must lie off"):
+        potential_matrix(POT_LAME_DL, bem.kp, 2, [[0.0, 0.0], [0.2, 0.5]], bem.V_space)

@@ -46,7 +46,7 @@ import scipy.linalg as sla
 import scipy.sparse as sp
 
 from ..bem.lame import LameBEM
-from ..bem.potentials import POT_LAME_DL, evaluate_potential
+from ..bem.potentials import POT_LAME_DL, potential_matrix
 from ..checks import array, instance
 from ..fem.newton_potential import CellComplex, edge_integrals, kelvin_constants, \
     newton_operators
@@ -250,17 +250,6 @@ class CellStrainOperators:
             X = X - VC @ np.linalg.solve(C.T @ VC, C.T @ X)
         return X
 
-    def _columns(self, fn, n: int, pts: np.ndarray, width: int) -> np.ndarray:
-        """Matrix whose column k is fn(pts, e_k) flattened (one vectorised potential
-        evaluation per basis function)."""
-        out = np.empty((len(pts) * width, n))
-        e = np.zeros(n)
-        for k in range(n):
-            e[k] = 1.0
-            out[:, k] = fn(pts, e).ravel()
-            e[k] = 0.0
-        return out
-
     def _build(self):
         """The cell-average displacement gradients g_c = |c|^-1 int_{d c} u (x) n ds
         (rows 4 c + 2 i + m) as A_u u + A_tau tau, and G = (area-weighted A_u)^T."""
@@ -330,11 +319,9 @@ class CellStrainOperators:
         points Y (the initial-strain Somigliana identity, module doc:
         u = V~ Psi(u) - K~ u + w - V~ P <w, .>)."""
         bem = self.bem
-        nV = 2 * bem.V_space.ndof
         Y = np.atleast_2d(np.asarray(Y, dtype=float))
         SL = self._single_layer(Y)                                       # (2Y, nW)
-        DL = -self._columns(lambda p, e: evaluate_potential(POT_LAME_DL, bem.kp, 2, p,
-                                                            bem.V_space, e), nV, Y, 2)
+        DL = -potential_matrix(POT_LAME_DL, bem.kp, 2, Y, bem.V_space)   # (2Y, nV)
         if getattr(self, "_PB", None) is None:
             self._PB = (self._P(bem.B), self._P(self._boundary_w()))
         Nw, _ = newton_operators(self.cells, Y, self.E, self.nu, gradient=False)
