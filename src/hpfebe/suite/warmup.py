@@ -96,9 +96,9 @@ def _plastic(steps: dict) -> None:
     body.internal_force(np.zeros(body.ndofs))
     steps["plasticity"] = time.perf_counter() - t
 
-    # the BE work piece (Example 2's BE/BE runs): the cell checks, containment and the
-    # cell-strain Jacobian kernels of hpfebe.bodies (~1.5 s compiled inside the job
-    # before)
+    # the BE work piece (Example 2's BE/BE runs): the cell checks, containment, the
+    # double layer matrix (bem.potentials.potential_matrix) and the cell-strain Jacobian
+    # kernels of hpfebe.bodies (compiled inside ch4_plasticity__ex2 before: jit 4.0 s)
     from ..bodies.plastic_be import rectangle_work_piece
 
     t = time.perf_counter()
