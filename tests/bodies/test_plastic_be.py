@@ -367,3 +367,124 @@ def test_times_blocks_is_the_batched_matmul():
     # and not a looser agreement: one block's product transposed is far outside it
     wrong = _times_blocks(A, np.swapaxes(D, 1, 2))
     assert not np.all(np.abs(wrong - ref) <= bound)
+
+def test_plastic_blocks_are_the_copies_they_replace():
+    """The fused kernel of the cell-strain Jacobian gives the numbers of the copies it
+    replaced bit for bit: MD = M[:, p] blockdiag(D[pl]) (the 3-term sums of
+    _times_blocks) and J = I - MD[p]; and the D blocks by indexing equal the einsum over
+    the selectors bit for bit (it adds only exact zeros)."""
+    from hpfebe.bodies.plastic_be import (_EPS_SEL, _TAU_SEL, _plastic_blocks,
+                                          _tau_strain_blocks, _times_blocks)
+    rng = np.random.default_rng(7)
+    nc = 30
+    M = rng.standard_normal((3 * nc, 3 * nc))
+    D = rng.standard_normal((nc, 3, 3))
+    pl = np.sort(rng.choice(nc, 17, replace=False))
+    p3 = (3 * pl[:, None] + np.arange(3)).ravel()
+    MD, J = _plastic_blocks(M, pl, D)
+    ref = _times_blocks(M[:, p3], D[pl])
+    assert np.array_equal(MD, ref)
+    assert np.array_equal(J, np.eye(p3.size) - ref[p3])
+    rows = np.setdiff1d(np.arange(3 * nc), p3)            # the elastic rows (a step)
+    MDe, Je = _plastic_blocks(M, pl, D, rows)
+    assert np.array_equal(MDe, ref[rows]) and np.array_equal(Je, J)
+    assert not np.array_equal(J, np.eye(p3.size) - _times_blocks(M[:, p3], D[pl[::-1]])[p3])
+    X = rng.standard_normal((11, 3, 3, 3, 3))          # not symmetric: every entry counts
+    want = np.einsum("aij,cijkl,bkl->cab", _TAU_SEL, X, _EPS_SEL)
+    assert np.array_equal(_tau_strain_blocks(X), want)
+    X[:, 0, 1, 1, 0] += 1.0
+    assert not np.array_equal(_tau_strain_blocks(X), want)
+
+
+def _plastic_punch(be):
+    """A boundary displacement of the punch with plastic cells (a compressed top, a
+    fixed bottom), and its fixed dofs."""
+    xy = be.bem.mesh.nodes
+    X = np.zeros((be.bem.V_space.ndof, 2))
+    X[be.bem.V_space.elem_dofs[:, 0]] = xy[be.bem.mesh.elements[:, 0]]
+    u = np.zeros(be.ndofs)
+    u[1::2] = -0.02 * X[:, 1] * (np.abs(X[:, 0]) < 0.5)
+    return u
+
+
+def test_lazy_tangent_and_prediction_are_the_dense_ones(punch_bodies):
+    """The tangent of implicit_response_lazy (LU at the inner solution, computed on its
+    first call) equals K_T = S - G_p D_p (I - M_pp D_p)^-1 B_p by a dense solve, the lazy
+    force equals internal_force's, and the next call's prediction (de/du) v through the
+    same LU equals (B + M_p D_p X) v."""
+    from hpfebe.bodies.plastic_be import _plastic_blocks, _times_blocks
+    _, be0 = punch_bodies
+    be = ElastoPlasticBE(be0.bem, be0.cells, MAT, scheme="implicit")
+    u = _plastic_punch(be)
+    tau, rm, tangent = be.implicit_response_lazy(u)
+    pl = np.flatnonzero(rm.plastic)
+    assert pl.size > 3
+    M, B = be._strain_operators()
+    p3 = (3 * pl[:, None] + np.arange(3)).ravel()
+    e = be._ilast[1]
+    D = _CellD(be, M, B @ u, e)
+    MD, J = _plastic_blocks(M, pl, D)
+    X = np.linalg.solve(J, B[p3])
+    KT = be.S - _times_blocks(be.G[:, p3], D[pl]) @ X
+    scale = np.abs(KT).max()
+    assert np.abs(tangent() - KT).max() < 1e-12 * scale
+    assert tangent() is tangent()                        # computed once
+    f, lazy = be.internal_force_lazy(u)
+    f2, K2 = be.internal_force(u)
+    assert np.array_equal(f, f2) and np.abs(lazy().toarray() - KT).max() < 1e-12 * scale
+    v = np.random.default_rng(3).standard_normal(be.ndofs)
+    dE = B + MD @ X
+    got = be._strain_derivative_times(be._ilast, v)
+    assert np.abs(got - dE @ v).max() < 1e-12 * np.abs(dE @ v).max()
+
+
+def _CellD(be, M, b, e):
+    """The D blocks of the inner problem at the cell strains e."""
+    from hpfebe.bodies.plastic_be import _CellStrainProblem
+    return _CellStrainProblem(be, M, b).evaluate(e).data[2]
+
+
+def test_work_pieces_of_one_geometry_share_their_operators():
+    """rectangle_work_piece with the same geometry and elastic constants (another theta)
+    shares the LameBEM, the cells and the operators (read-only), and gives the forces of
+    a work piece built anew bit for bit; another geometry builds its own."""
+    from hpfebe.bodies import plastic_be, cell_operators
+    from hpfebe.bodies.plastic_be import rectangle_work_piece
+    box = (-2.0, 2.0, -3.0, -1.0)
+    m1, m0 = (J2Material(1000.0, 0.3, 1.0, 20.0, th) for th in (1.0, 0.0))
+    a = rectangle_work_piece(box, 4, 2, m1, scheme="implicit", cells="crossed")
+    b = rectangle_work_piece(box, 4, 2, m0, scheme="implicit", cells="crossed")
+    assert b.bem is a.bem and b.cells is a.cells and b.A_tau is a.A_tau and b.G is a.G
+    assert not b.A_tau.flags.writeable and not a.A_u.flags.writeable
+    c = rectangle_work_piece(box, 4, 3, m0, scheme="implicit", cells="crossed")
+    assert c.bem is not a.bem
+    plastic_be._WORK_PIECES.clear()
+    cell_operators._SHARED.clear()
+    fresh = rectangle_work_piece(box, 4, 2, m0, scheme="implicit", cells="crossed")
+    assert fresh.bem is not a.bem
+    for name in ("A_u", "A_tau", "G", "S"):
+        assert np.array_equal(getattr(fresh, name), getattr(b, name))
+    u = _plastic_punch(b)
+    assert np.array_equal(b.internal_force(u)[0], fresh.internal_force(u)[0])
+
+
+def test_potential_matrix_is_the_columns_of_evaluate_potential():
+    """The double layer matrix of the cell operators (one pass over the point-element
+    pairs) equals the potential of every unit density evaluated column by column bit for
+    bit, near and far points (far tables, >= 32 points) alike; a point on Gamma is
+    refused."""
+    from hpfebe.bem.potentials import (POT_LAME_DL, PointOnBoundaryError,
+                                       evaluate_potential, potential_matrix)
+    bm = BoundaryMesh.polygon([(-1, 0), (1, 0), (1, 1), (-1, 1)], n=[8, 3, 8, 3])
+    bem = LameBEM(bm, MAT.E, MAT.nu)
+    rng = np.random.default_rng(5)
+    Y = np.vstack([np.column_stack([rng.uniform(-0.99, 0.99, 60), rng.uniform(0.01, 0.99, 60)]),
+                   [[0.0, 1e-4], [0.999, 0.5], [-0.3, 0.9999]]])
+    n = 2 * bem.V_space.ndof
+    cols = np.column_stack([evaluate_potential(POT_LAME_DL, bem.kp, 2, Y, bem.V_space,
+                                               np.eye(n)[k]).ravel() for k in range(n)])
+    A = potential_matrix(POT_LAME_DL, bem.kp, 2, Y, bem.V_space)
+    assert A.shape == (2 * len(Y), n) and np.abs(A).max() > 0
+    assert np.array_equal(A, cols)
+    with pytest.raises(PointOnBoundaryError, match="points must lie off"):
+        potential_matrix(POT_LAME_DL, bem.kp, 2, [[0.0, 0.0], [0.2, 0.5]], bem.V_space)

@@ -46,7 +46,7 @@ import scipy.linalg as sla
 import scipy.sparse as sp
 
 from ..bem.lame import LameBEM
-from ..bem.potentials import POT_LAME_DL, evaluate_potential
+from ..bem.potentials import POT_LAME_DL, potential_matrix
 from ..checks import array, instance
 from ..fem.newton_potential import CellComplex, edge_integrals, kelvin_constants, \
     newton_operators
@@ -169,7 +169,8 @@ def check_cells(mesh, cx: CellComplex) -> None:
         raise ValueError(f"cells must lie inside the body: the boundary element {k} "
                          f"({mesh.a[k].tolist()} to {mesh.b[k].tolist()}) cuts cell {c} "
                          f"(vertices {P[c].tolist()})")
-    i, j = _first_overlap(nodes, np.ascontiguousarray(cx.cells, dtype=np.int64),
+    i, j = _first_overlap(np.ascontiguousarray(nodes),      # one specialisation
+                          np.ascontiguousarray(cx.cells, dtype=np.int64),
                           np.ascontiguousarray(cx.centroids), tol)
     if i >= 0:
         raise ValueError(f"cells must not overlap: cells {i} (vertices {P[i].tolist()}) "
@@ -187,6 +188,22 @@ def match_nodes(points: np.ndarray, nodes: np.ndarray, tol: float) -> np.ndarray
     return np.where(d[np.arange(len(points)), j] <= tol, j, -1)
 
 
+SHARED = ("S", "K", "A_u", "A_tau", "G", "_PB")
+SHARED_MAX = 2
+_SHARED: list = []
+
+
+def _shared(bem, cells, E: float, nu: float) -> dict | None:
+    """The operators built before for the same ``bem`` and ``cells`` objects and elastic
+    constants (the BE/BE runs of one mesh for every theta, whose work pieces
+    :func:`hpfebe.bodies.plastic_be.rectangle_work_piece` gives the same bem and cells),
+    or None.  The last SHARED_MAX are kept, read-only."""
+    for b, c, e, n, ops in _SHARED:
+        if b is bem and c is cells and e == float(E) and n == float(nu):
+            return ops
+    return None
+
+
 class CellStrainOperators:
     """The operators of a BE body of degree 1 (``bem``, plane strain) with piecewise
     constant initial strain on ``cells`` (its nodes on Gamma coinciding with BEM nodes),
@@ -201,14 +218,27 @@ class CellStrainOperators:
             raise ValueError(f"bem must be plane strain (J2 body), got plane={bem.plane!r}")
         if not np.all(bem.mesh.degrees == 1):
             raise ValueError("bem must have degree 1 on every element (P1 displacements)")
-        check_cells(bem.mesh, cells)
+        shared = _shared(bem, cells, E, nu)
+        if shared is None:
+            check_cells(bem.mesh, cells)
         self.bem, self.cells = bem, cells
         self.E, self.nu = E, nu
         self.ndofs = 2 * bem.V_space.ndof
+        self.points = cells.centroids
+        if shared is not None:
+            for name, value in shared.items():
+                setattr(self, name, value)
+            return
         self.S = bem.S_hat
         self.K = sp.csr_matrix(self.S)
-        self.points = cells.centroids
         self._build()
+        ops = {name: getattr(self, name) for name in SHARED}
+        for name in ("A_u", "A_tau", "G"):
+            ops[name].setflags(write=False)
+        for X in ops["_PB"]:
+            X.setflags(write=False)
+        _SHARED.append((bem, cells, float(E), float(nu), ops))
+        del _SHARED[:-SHARED_MAX]
 
     def _P(self, Y: np.ndarray) -> np.ndarray:
         """Constrained V^{-1} (zero total force, as LameBEM.Psi) applied to columns Y."""
@@ -219,17 +249,6 @@ class CellStrainOperators:
             VC = sla.cho_solve(bem.V_cho, C)
             X = X - VC @ np.linalg.solve(C.T @ VC, C.T @ X)
         return X
-
-    def _columns(self, fn, n: int, pts: np.ndarray, width: int) -> np.ndarray:
-        """Matrix whose column k is fn(pts, e_k) flattened (one vectorised potential
-        evaluation per basis function)."""
-        out = np.empty((len(pts) * width, n))
-        e = np.zeros(n)
-        for k in range(n):
-            e[k] = 1.0
-            out[:, k] = fn(pts, e).ravel()
-            e[k] = 0.0
-        return out
 
     def _build(self):
         """The cell-average displacement gradients g_c = |c|^-1 int_{d c} u (x) n ds
@@ -300,11 +319,9 @@ class CellStrainOperators:
         points Y (the initial-strain Somigliana identity, module doc:
         u = V~ Psi(u) - K~ u + w - V~ P <w, .>)."""
         bem = self.bem
-        nV = 2 * bem.V_space.ndof
         Y = np.atleast_2d(np.asarray(Y, dtype=float))
         SL = self._single_layer(Y)                                       # (2Y, nW)
-        DL = -self._columns(lambda p, e: evaluate_potential(POT_LAME_DL, bem.kp, 2, p,
-                                                            bem.V_space, e), nV, Y, 2)
+        DL = -potential_matrix(POT_LAME_DL, bem.kp, 2, Y, bem.V_space)   # (2Y, nV)
         if getattr(self, "_PB", None) is None:
             self._PB = (self._P(bem.B), self._P(self._boundary_w()))
         Nw, _ = newton_operators(self.cells, Y, self.E, self.nu, gradient=False)

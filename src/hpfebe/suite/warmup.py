@@ -11,7 +11,8 @@ specialisations (argument types) that the experiments use: the BEM assembly of t
 Laplace and Lame operators (the p = 1 closed forms and the general quadrature path), the
 potentials at interior points, the gradient of the single layer on Gamma (the residual
 estimator), boundary-curve checks, Polyak's projected CG and the Uzawa step of the
-mortar solvers, and the strain/force kernels of the plastic body.
+mortar solvers, the strain/force kernels of the plastic body and the cell kernels of the
+plastic BE work piece.
 """
 
 from __future__ import annotations
@@ -94,6 +95,22 @@ def _plastic(steps: dict) -> None:
                            J2Material(1.0, 0.3, 1.0, 0.1))
     body.internal_force(np.zeros(body.ndofs))
     steps["plasticity"] = time.perf_counter() - t
+
+    # the BE work piece (Example 2's BE/BE runs): the cell checks, containment, the
+    # double layer matrix (bem.potentials.potential_matrix) and the cell-strain Jacobian
+    # kernels of hpfebe.bodies (compiled inside ch4_plasticity__ex2 before: jit 4.0 s)
+    from ..bodies.plastic_be import rectangle_work_piece
+
+    t = time.perf_counter()
+    be = rectangle_work_piece((0.0, 1.0, 0.0, 1.0), 1, 1, J2Material(1.0, 0.3, 1e-3, 0.1),
+                              scheme="implicit", cells="crossed")
+    mesh, space = be.bem.mesh, be.bem.V_space
+    X = np.zeros((space.ndof, 2))                    # the node of each P1 dof
+    X[space.elem_dofs[:, 0]] = mesh.nodes[mesh.elements[:, 0]]
+    u = np.zeros(be.ndofs)
+    u[0::2], u[1::2] = 0.01 * X[:, 0], -0.01 * X[:, 1]   # 10 yield strains: plastic cells
+    be.internal_force(u)
+    steps["plastic_be"] = time.perf_counter() - t
 
 
 def _hmatrix(steps: dict) -> None:

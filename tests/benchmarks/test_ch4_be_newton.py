@@ -1,0 +1,61 @@
+"""pytest-benchmark of one Newton step of the BE/BE pair of Example 2 (Chapter 4,
+thesis Section 4.2.4 with the plastic BE work piece of Algorithm 4.2, backward Euler
+cells): the BE stamp [-1, 1] x [-1, 0] (degree 1) on the BE work piece [-2, 2] x [-3, -1]
+with crossed cells of size bebe_h = 0.4 (10 x 5 squares, 200 triangles, 600 cell
+strains), frictional penalty contact, at the first increment's bonded predictor iterate
+(skipped by default, ``--benchmark-skip`` in pyproject.toml; run with
+``NUMBA_NUM_THREADS=1 pytest tests/benchmarks/test_ch4_be_newton.py --benchmark-only``).
+
+One step = the residual at an iterate (the inner backward Euler solve of the cell
+strains, :meth:`ElastoPlasticBE.implicit_response_lazy`: a dense LU of I - M_pp D_p per
+inner iteration) and the Newton update (the consistent tangent
+S_hat - G_p D_p (I - M_pp D_p)^-1 B_p from the LU at the inner solution, the dense
+contact system).
+"""
+
+import numpy as np
+
+from hpfebe.bodies.plastic_be import PlasticBEBody
+from hpfebe.constitutive.j2 import J2Material
+from hpfebe.contact import ContactSettings, TwoBodyContact
+from hpfebe.contact.loading import LoadSteps
+from hpfebe.scenes.materials import E, H, NU, SIGMA_Y
+from hpfebe.scenes.stamping import be_work_piece, stamp_body
+
+H_BEBE = 0.4
+WORK = (-2.0, 2.0, -3.0, -1.0)
+STAMP = (-1.0, 1.0, -1.0, 0.0)
+LIFT = 4.2e-4                  # the first increment of Example 2 (4.2e-3 in 10)
+
+
+def _stepper(problem, x):
+    """One Newton step, alternating between x and a copy moved at round-off level (the
+    BE body caches its state at the last u: every call computes it anew)."""
+    xs, k = (x, x * (1.0 + 1e-13)), [0]
+
+    def step():
+        k[0] += 1
+        return problem.step(problem.evaluate(xs[k[0] % 2]))
+
+    return step
+
+
+def test_bench_newton_step_bebe(benchmark):
+    """A Newton step of the first increment of Example 2's BE/BE run (theta = 1) at the
+    bonded predictor's iterate (a plastic zone under the stamp)."""
+    be = be_work_piece(WORK, H_BEBE, J2Material(E, NU, SIGMA_Y, H, 1.0), "crossed")
+    stamp = stamp_body("BE", STAMP, H_BEBE, E, NU, p=1)
+    pr = TwoBodyContact(stamp, PlasticBEBody(be), "bottom", "top", eps_n=1 / (10 * E),
+                        eps_t=1 / (5 * E), mu_f=0.2)
+    fixed, is_y = pr.stamp_dofs()
+    settings = ContactSettings(rtol=1e-8, max_iter=40, line_search=True, predictor=True,
+                               lu_ordering="MMD_AT_PLUS_A")
+    steps = LoadSteps(pr, None, fixed, np.where(is_y, LIFT, 0.0), settings)
+    steps.problem(1.0)
+    x = steps.start(np.zeros(pr.ndofs), 1.0)
+    x = steps.bonded_predictor(steps.evaluate(x))
+    plastic = be.implicit_response(x[pr.offset:])[1].plastic
+    assert plastic.mean() > 0.1
+    dx = steps.step(steps.evaluate(x))
+    assert np.all(np.isfinite(dx)) and np.abs(dx).max() > 0
+    benchmark(_stepper(steps, x))
