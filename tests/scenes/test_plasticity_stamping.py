@@ -84,6 +84,29 @@ def test_second_touch_continues_the_history():
         assert -uy[(x > lo) & (x < hi)].mean() > 2e-3
 
 
+def test_open_start_solves_open_increments_at_once():
+    """Two unloading increments: the second starts from the first (contact open) moved
+    rigidly, which is its solution (no Newton iteration); the secant extrapolation
+    (open_start=False) iterates to the same state."""
+    mat = J2Material(E, NU, 4.0, 450.0, 1.0)
+    out = {}
+    for flag in (True, False):
+        fe = work_piece(WORK, 0.4, mat)
+        tr = touch(stamp_body("FE", (-1.0, 1.0, -1.0, 0.0), 0.4, E, NU), fe, 4.2e-3, 4, 2,
+                   (1.0, -1.1), StampContact(open_start=flag))
+        assert tr.converged, tr.reason
+        assert [r.phase for r in tr.records[-2:]] == ["unload", "unload"]
+        out[flag] = tr
+    new, old = out[True], out[False]
+    assert new.records[-1].iterations == 0 < old.records[-1].iterations
+    assert [r.iterations for r in new.records[:-1]] == \
+        [r.iterations for r in old.records[:-1]]
+    scale = np.abs(old.u_work).max()
+    assert np.abs(new.u_work - old.u_work).max() <= 1e-8 * scale
+    with pytest.raises(ValueError, match="open_start"):
+        StampContact(open_start="yes")
+
+
 def test_bad_input():
     with pytest.raises(ValueError, match="kind"):
         stamp_body("XE", (0, 1, 0, 1), 0.5, E, NU)
