@@ -210,7 +210,7 @@ class StampingScene:
     eps_n_factor: float = 10.0
     eps_t_factor: float = 5.0
     rtol: float = 1e-8
-    max_newton: int = 40
+    max_newton: int = 60
     max_cuts: int = 4
     predictor: bool = True               # bonded predictor of TwoBodyContact per increment
     n_load: int = 10
