@@ -63,7 +63,7 @@ CHOICES = (
     "states (at the first unloading increment, and after an increment that ended with "
     "the contact open: the work piece moved rigidly, the stamp at rest, no predictor "
     "while no point is in contact), or from TwoBodyContact's bonded predictor when that "
-    "lowers ||R||; Armijo line search on ||R|| (an accepted step below 1 halved further "
+    "lowers ||R|| (tried in the first two increments of a touch only); Armijo line search on ||R|| (an accepted step below 1 halved further "
     "while ||R|| decreases, ls_refine = 3 times at most; at most max_newton = 60 "
     "iterations), stop at ||R|| <= rtol x force scale + rtol x the reference "
     "force (the work piece's width times the smaller of sigma_Y and the elastic stress of "
