@@ -19,6 +19,8 @@ def test_defaults_and_newton_options():
     assert ls.enabled and ls.accept_last and ls.max_halvings == 5 and ls.slack == 0.0
     ls = ContactSettings(line_search=True, merit="energy").line_search_rule()
     assert ls.max_halvings == 30 and not ls.accept_last
+    assert ContactSettings().line_search_rule().refine == 0
+    assert ContactSettings(line_search=True, ls_refine=3).line_search_rule().refine == 3
     assert ContactSettings(norm="max").newton_options()["norm"] == np.inf
     with pytest.raises(dataclasses.FrozenInstanceError):
         s.rtol = 1.0
@@ -30,7 +32,8 @@ def test_defaults_and_newton_options():
     (dict(max_cuts=-1), "max_cuts"), (dict(min_step=0.0), "min_step"),
     (dict(norm="l1"), "norm"), (dict(merit="work"), "merit"),
     (dict(lu_ordering="AMD"), "lu_ordering"), (dict(linear_solver="cg"), "linear_solver"),
-    (dict(line_search=1), "line_search"), (dict(predictor="yes"), "predictor")])
+    (dict(line_search=1), "line_search"), (dict(predictor="yes"), "predictor"),
+    (dict(ls_refine=-1), "ls_refine"), (dict(ls_refine=0.5), "ls_refine")])
 def test_wrong_settings_are_named(kw, name):
     with pytest.raises(ValueError, match=name):
         ContactSettings(**kw)

@@ -84,6 +84,56 @@ def test_second_touch_continues_the_history():
         assert -uy[(x > lo) & (x < hi)].mean() > 2e-3
 
 
+def test_open_start_solves_open_increments_at_once():
+    """Two unloading increments: the second starts from the first (contact open) moved
+    rigidly, which is its solution (no Newton iteration); the secant extrapolation
+    (open_start=False) iterates to the same state."""
+    mat = J2Material(E, NU, 4.0, 450.0, 1.0)
+    out = {}
+    for flag in (True, False):
+        fe = work_piece(WORK, 0.4, mat)
+        tr = touch(stamp_body("FE", (-1.0, 1.0, -1.0, 0.0), 0.4, E, NU), fe, 4.2e-3, 4, 2,
+                   (1.0, -1.1), StampContact(open_start=flag))
+        assert tr.converged, tr.reason
+        assert [r.phase for r in tr.records[-2:]] == ["unload", "unload"]
+        out[flag] = tr
+    new, old = out[True], out[False]
+    assert new.records[-1].iterations == 0 < old.records[-1].iterations
+    assert [r.iterations for r in new.records[:-1]] == \
+        [r.iterations for r in old.records[:-1]]
+    scale = np.abs(old.u_work).max()
+    assert np.abs(new.u_work - old.u_work).max() <= 1e-8 * scale
+    with pytest.raises(ValueError, match="open_start"):
+        StampContact(open_start="yes")
+
+
+def test_bonded_predictor_only_in_the_first_increments(monkeypatch):
+    """bonded_increments = 2: the bonded predictor is tried in increments 1-2 only (later
+    ones start from the secant extrapolation); None tries it in every increment; the
+    states agree to the solver's tolerance."""
+    from hpfebe.contact.loading import LoadSteps
+    calls = []
+    orig = LoadSteps.bonded_predictor
+    monkeypatch.setattr(LoadSteps, "bonded_predictor",
+                        lambda self, it: calls.append(1) or orig(self, it))
+    mat = J2Material(E, NU, 4.0, 450.0, 1.0)
+    out = {}
+    for n in (2, None):
+        calls.clear()
+        fe = work_piece(WORK, 0.4, mat)
+        tr = touch(stamp_body("FE", (-1.0, 1.0, -1.0, 0.0), 0.4, E, NU), fe, 4.2e-3, 5, 0,
+                   (1.0, -1.1), StampContact(bonded_increments=n))
+        assert tr.converged, tr.reason
+        out[n] = (len(calls), tr)
+    assert out[2][0] == 2 and out[None][0] == 5
+    f2 = np.array([r.force for r in out[2][1].records])
+    fn = np.array([r.force for r in out[None][1].records])
+    assert np.abs(f2 - fn).max() <= 1e-6 * np.abs(fn).max()
+    for bad in (-1, 1.5):
+        with pytest.raises(ValueError, match="bonded_increments"):
+            StampContact(bonded_increments=bad)
+
+
 def test_bad_input():
     with pytest.raises(ValueError, match="kind"):
         stamp_body("XE", (0, 1, 0, 1), 0.5, E, NU)

@@ -58,7 +58,10 @@ class ContactSettings:
     bodies' stiffness for the whole load path and the contact terms by the
     Sherman-Morrison-Woodbury formula on the active points
     (:class:`hpfebe.contact.loading.WoodburySolver`: the same Newton steps up to
-    round-off; measured 7x less CPU on 83,076 dofs with 640 contact points)."""
+    round-off; measured 7x less CPU on 83,076 dofs with 640 contact points).
+    ``ls_refine``: the ``refine`` of the residual line search
+    (:class:`hpfebe.solvers.LineSearch`: an accepted step below 1 halved further while
+    ||R|| decreases, at most this many times; 0 = plain Armijo backtracking)."""
 
     rtol: float = 1e-10
     atol: float = 0.0
@@ -72,6 +75,7 @@ class ContactSettings:
     roundoff_stop: bool = False
     lu_ordering: str = "COLAMD"
     linear_solver: str = "lu"
+    ls_refine: int = 0
 
     def __post_init__(self):
         # every field checked by hpfebe.checks and stored as a Python float/int/bool
@@ -85,6 +89,7 @@ class ContactSettings:
         put("atol", real("atol", self.atol, nonnegative=True))
         put("max_iter", integer("max_iter", self.max_iter, lo=1))
         put("max_cuts", integer("max_cuts", self.max_cuts, lo=0))
+        put("ls_refine", integer("ls_refine", self.ls_refine, lo=0))
         put("min_step", real("min_step", self.min_step, lo=0.0, hi=1.0, lo_open=True))
         for name, allowed in (("norm", NORMS), ("merit", MERITS),
                               ("lu_ordering", LU_ORDERINGS),
@@ -118,7 +123,8 @@ class ContactSettings:
         if self.merit == "energy":
             return LineSearch(enabled=self.line_search)
         return LineSearch(slack=0.0, max_halvings=int(round(-np.log2(self.min_step))),
-                          accept_last=True, enabled=self.line_search)
+                          accept_last=True, enabled=self.line_search,
+                          refine=self.ls_refine)
 
     def newton_options(self) -> dict:
         """The keywords of :func:`hpfebe.solvers.newton` (the predictor is the

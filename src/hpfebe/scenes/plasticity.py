@@ -60,9 +60,12 @@ CHOICES = (
     "element means averaged over the elements touching X (one to four: Example 2's X = (1, "
     "-1.1) lies on an element edge for h = 0.2 and is a mesh vertex for h <= 0.1).",
     "Newton: each increment starts from the secant extrapolation of the last two converged "
-    "states (at the first unloading increment: the work piece lowered rigidly, the stamp "
-    "at rest), or from TwoBodyContact's bonded predictor when that lowers ||R||; Armijo "
-    "line search on ||R||, stop at ||R|| <= rtol x force scale + rtol x the reference "
+    "states (at the first unloading increment, and after an increment that ended with "
+    "the contact open: the work piece moved rigidly, the stamp at rest, no predictor "
+    "while no point is in contact), or from TwoBodyContact's bonded predictor when that "
+    "lowers ||R|| (tried in the first two increments of a touch only); Armijo line search on ||R|| (an accepted step below 1 halved further "
+    "while ||R|| decreases, ls_refine = 3 times at most; at most max_newton = 60 "
+    "iterations), stop at ||R|| <= rtol x force scale + rtol x the reference "
     "force (the work piece's width times the smaller of sigma_Y and the elastic stress of "
     "the lift: scenes.stamping.reference_force; sigma_Y in every thesis scene); a "
     "failed increment is halved (at most max_cuts times).",
@@ -210,7 +213,7 @@ class StampingScene:
     eps_n_factor: float = 10.0
     eps_t_factor: float = 5.0
     rtol: float = 1e-8
-    max_newton: int = 40
+    max_newton: int = 60
     max_cuts: int = 4
     predictor: bool = True               # bonded predictor of TwoBodyContact per increment
     n_load: int = 10
@@ -220,6 +223,7 @@ class StampingScene:
     be_degree: int = 1
     bebe_cells: str = "crossed"
     lu_ordering: str = "MMD_AT_PLUS_A"   # sparse LU ordering (ContactSettings)
+    ls_refine: int = 3                   # line search refinement (ContactSettings)
 
     def __post_init__(self):
         choice("lu_ordering", self.lu_ordering, LU_ORDERINGS)
@@ -241,7 +245,8 @@ class StampingScene:
                             solver=ContactSettings(
                                 rtol=self.rtol, max_iter=self.max_newton,
                                 max_cuts=self.max_cuts, line_search=True,
-                                predictor=self.predictor, lu_ordering=self.lu_ordering))
+                                predictor=self.predictor, lu_ordering=self.lu_ordering,
+                                ls_refine=self.ls_refine))
 
     def material(self, theta: float) -> J2Material:
         return J2Material(self.E, self.nu, self.sigma_Y, self.H, theta)

@@ -21,13 +21,19 @@ class LineSearch:
     merit(x + alpha dx) <= merit(x) + c alpha slope + slack |merit(x)|; after
     ``max_halvings`` halvings either fail ("line search failed") or, with
     ``accept_last``, take the last trial step.  ``enabled=False``: always the full
-    step."""
+    step.  ``refine``: when the accepted alpha is below 1, halve it further (at most
+    ``refine`` times, within ``max_halvings``) while the merit decreases, and take the
+    lowest merit: residual evaluations are cheap beside a Newton system, and the first
+    acceptable alpha of a far iterate is often not the best one (measured, Example 1 of
+    Section 4.2.7, h = 0.05: first increment 40 -> 24 iterations with refine = 3, the
+    residual evaluations about the same)."""
 
     c: float = 1e-4
     slack: float = 1e-14
     max_halvings: int = 30
     accept_last: bool = False
     enabled: bool = True
+    refine: int = 0
 
 
 def _line_search(problem, it: Iterate, dx: np.ndarray, ls: LineSearch):
@@ -40,10 +46,30 @@ def _line_search(problem, it: Iterate, dx: np.ndarray, ls: LineSearch):
         trial = problem.evaluate(it.x + alpha * dx)
         ok = np.isfinite(trial.merit) and \
             trial.merit <= it.merit + ls.c * alpha * slope + ls.slack * abs(it.merit)
+        if ok and alpha < 1.0 and ls.refine > 0:
+            return _refined(problem, it, dx, ls, alpha, trial, k)
         if ok or (ls.accept_last and k == ls.max_halvings):
             return alpha, trial
         alpha *= 0.5
     return alpha, None
+
+
+def _refined(problem, it: Iterate, dx: np.ndarray, ls: LineSearch, alpha: float, trial,
+             k: int):
+    """The accepted (alpha, trial) of :func:`_line_search` halved further while the
+    merit decreases (``ls.refine`` times at most, ``ls.max_halvings`` in all)."""
+    best, last = (alpha, trial), trial
+    for _ in range(min(int(ls.refine), ls.max_halvings - k)):
+        a = 0.5 * best[0]
+        last = problem.evaluate(it.x + a * dx)
+        if not (np.isfinite(last.merit) and last.merit < best[1].merit):
+            break
+        best = (a, last)
+    if last is not best[1]:
+        # the problem's last evaluation is the returned iterate (bodies caching their
+        # state at the last point see the point taken)
+        best = (best[0], problem.evaluate(best[1].x))
+    return best
 
 
 def newton(problem: NewtonProblem, x0: np.ndarray, tol: float, max_iter: int = 50,
@@ -107,6 +133,7 @@ def newton(problem: NewtonProblem, x0: np.ndarray, tol: float, max_iter: int = 5
     max_iter = integer("max_iter", max_iter, lo=0)
     x0 = array("x0", x0)
     ls = line_search or LineSearch()
+    integer("line_search.refine", ls.refine, lo=0)
     it = problem.evaluate(x0)
     info = SolverInfo(False, "max_iter", 0, [residual_norm(it.residual, norm)], [],
                       [it.merit])
