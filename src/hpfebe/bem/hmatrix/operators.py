@@ -15,8 +15,10 @@ permutation.  Then (Section 1.4, :mod:`hpfebe.bem.operators`)
     B = K + M/2,   Psi = P B U,   S_hat = W + B^T P B,
     P = V^{-1} - V^{-1} C (C^T V^{-1} C)^{-1} C^T V^{-1}   (constrained),
 
-with every V^{-1} a preconditioned CG solve (block-diagonal near-field Cholesky,
-:class:`~.solvers.BlockJacobi`) to ``solver_tol``: V^{-1} is never formed.
+with every V^{-1} a preconditioned CG solve to ``solver_tol`` (the multilevel additive
+Schwarz preconditioner of :mod:`.precond`, or the block-diagonal near-field Cholesky
+:class:`~.solvers.BlockJacobi`: ``HMatrixSettings.preconditioner``): V^{-1} is never
+formed.
 """
 
 from __future__ import annotations
@@ -28,11 +30,12 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from ...checks import integer, real
+from ...checks import choice, integer, real
 from ..assembly import _element_geometry
 from .cluster import cluster_tree
 from .entries import rule_tuple
 from .matrix import HMatrix, Layout
+from .precond import Multilevel
 from .solvers import BlockJacobi, cg, dense_cholesky_solver, gmres, require
 
 
@@ -45,6 +48,7 @@ QTOL_MIN = 1e-16       # ... but never below the dense assembly's integration.TO
 TOL_FACTOR = {"V": 1.0, "K": 0.5, "W": 0.25}
 INNER_TOL_FRACTION = 1e-3   # default inner CG residual / tol (HMatrixSettings.inner_tol)
 INNER_TOL_MIN = 1e-14
+PRECONDITIONERS = ("multilevel", "jacobi")
 
 
 @dataclass(frozen=True)
@@ -52,7 +56,10 @@ class HMatrixSettings:
     """Compression settings: ``tol`` the relative (Frobenius) accuracy of every operator,
     in (0, 1); ``eta`` the admissibility parameter; ``leaf_size`` elements per leaf
     cluster (None: about 32 dofs per leaf); ``max_rank`` cap of the ACA rank;
-    ``solver_tol`` the relative residual of the inner CG solves (None: tol / 1000)."""
+    ``solver_tol`` the relative residual of the inner CG solves (None: tol / 1000);
+    ``preconditioner`` of the CG solves with V: "multilevel" (default; leaf blocks, Haar
+    functions per cluster and an exact coarse space, :mod:`.precond`: iterations nearly
+    constant in N) or "jacobi" (the leaf blocks only, :class:`~.solvers.BlockJacobi`)."""
 
     tol: float = 1e-8
     eta: float = 1.0
@@ -60,6 +67,7 @@ class HMatrixSettings:
     max_rank: int = 300
     solver_tol: float | None = None
     maxiter: int = 5000
+    preconditioner: str = "multilevel"
 
     def __post_init__(self):
         real("tol", self.tol, lo=0.0, hi=1.0, lo_open=True, hi_open=True)
@@ -69,6 +77,7 @@ class HMatrixSettings:
         real("solver_tol", self.solver_tol, lo=0.0, hi=1.0, lo_open=True, hi_open=True,
              allow_none=True)
         integer("maxiter", self.maxiter, lo=1)
+        choice("preconditioner", self.preconditioner, PRECONDITIONERS)
 
     @property
     def inner_tol(self) -> float:
@@ -221,11 +230,9 @@ class CompressedOperators:
     # ------------------------------------------------------------------ solves
     def solve_V(self, rhs: np.ndarray) -> np.ndarray:
         """V^{-1} rhs (global W_hp numbering; a vector or the columns of a matrix, solved
-        together) by block-Jacobi CG."""
+        together) by preconditioned CG (``settings.preconditioner``)."""
+        pre = self.preconditioner_V()
         H = self.hmatrix("V")
-        if "jacobi" not in self._cache:
-            self._cache["jacobi"] = BlockJacobi(H)
-        pre = self._cache["jacobi"]
         rhs = np.asarray(rhs, float)
         xb, info = cg(H.matvec, rhs[self.perm_W], pre.solve, tol=self.settings.inner_tol,
                       maxiter=self.settings.maxiter)
@@ -234,6 +241,21 @@ class CompressedOperators:
         out = np.empty_like(xb)
         out[self.perm_W] = xb
         return out
+
+    def preconditioner_V(self):
+        """The preconditioner of the CG solves with V (broken numbering), built on first
+        use: :class:`~.precond.Multilevel` or :class:`~.solvers.BlockJacobi`."""
+        kind = self.settings.preconditioner
+        if kind not in self._cache:
+            H = self.hmatrix("V")
+            t0 = time.process_time()
+            if kind == "jacobi":
+                self._cache[kind] = BlockJacobi(H)
+            else:
+                L = self.geom[3][self.tree.order]
+                self._cache[kind] = Multilevel(H, self.tree, self.lay_W, L, self.d)
+            self._cache[kind].cpu_s = time.process_time() - t0
+        return self._cache[kind]
 
     def _project(self, psi):
         """psi - V^{-1} C (C^T V^{-1} C)^{-1} C^T psi (the constraint of P), if any."""
