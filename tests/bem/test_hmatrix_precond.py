@@ -117,3 +117,15 @@ def test_preconditioner_keyword_checked():
     with pytest.raises(ValueError, match="preconditioner"):
         HMatrixSettings(preconditioner="ilu")
     assert HMatrixSettings().preconditioner == "multilevel"
+
+
+def test_lanczos_condition_estimate():
+    """CG's Lanczos estimate of cond(C^{-1} V) against the dense eigenvalues (Laplace
+    p = 1, N = 1024): a lower bound (Ritz values lie inside the spectrum) within 10 % of
+    it once CG has run to 1e-11 (the extreme Ritz values converge first)."""
+    for kind in ("multilevel", "jacobi"):
+        hm = _hm("laplace", 1024, 1, kind)
+        exact = _cond(hm)
+        hm.solve_V(np.random.default_rng(0).standard_normal(hm.hmatrix("V").shape[0]))
+        est = hm.solves[-1].counts["cond_estimate"]
+        assert exact * 0.9 <= est <= exact * (1 + 1e-8), kind
