@@ -23,9 +23,10 @@ Parts:
   dense and compressed (tol 1e-8), Laplace p = 1 and 4, Lame p = 1 and 2; the fitted
   exponents over the target ranges (p = 1: N = 4096 ... 65536, p >= 2: 1024 ... 16384),
   the compression ratio, the CG iterations on V (``cg_iterations``, summed over the
-  solves), the error against the exact data and, where dense ran, against
-  the dense solution; the dense error extrapolated to the largest N (fit over its last
-  three sizes) against the compressed error there.
+  solves) and CG's Lanczos estimate of cond(C^{-1} V) (``cond_estimate``), the error
+  against the exact data and, where dense ran, against the dense solution; the dense
+  error extrapolated to the largest N (fit over its last three sizes) against the
+  compressed error there.
 * ``tol``: error against dense and against the exact data as the tolerance varies.
 * ``matvec``: compressed V, K, W times a random vector against dense (relative 2-norm),
   Laplace and Lame, p = 1, 2, 4, at N = 4096, or the largest N whose dense matrix fits
@@ -117,6 +118,7 @@ def one_solve(spec: dict) -> dict:
         out["max_rank"] = max(res.info[k]["max_rank"] for k in ("V", "K"))
         out["sampled_error"] = max(res.info[k]["sampled_error"] for k in ("V", "K"))
         out["cg_iterations"] = int(sum(it for it, _ in res.info["solves"]))
+        out["cond_estimate"] = float(np.nanmax(res.info["cond_estimates"] or [np.nan]))
     return out
 
 
@@ -217,8 +219,11 @@ def _case_fits(pde, p, ok) -> list:
     out = []
     for method in ("dense", "hmatrix"):
         sub = [r for r in ok if r["method"] == method]
+        if not sub:                     # not run (--methods)
+            continue
         rng = (lo, hi) if method == "hmatrix" else (0, 10**9)
-        for key in ("total_s", "cpu_s", "run_mb", "storage_mb", "cg_iterations"):
+        keys = ("total_s", "cpu_s", "run_mb", "storage_mb")
+        for key in keys + (("cg_iterations",) if method == "hmatrix" else ()):
             e, n = _fit(sub, key, *rng)
             out.append(dict(part="fit", pde=pde, p=p, method=method, quantity=key,
                             exponent=e, points=n, N_lo=rng[0], N_hi=min(rng[1], 10**6)))
@@ -289,7 +294,8 @@ def part_check(Ns, timeout: float) -> list:
 
 
 SHOW = ("part", "pde", "p", "N", "method", "tol", "dof", "total_s", "cpu_s", "run_mb", "storage_mb",
-        "ratio", "cg_iterations", "error_exact", "err_vs_dense", "err_V", "err_K", "err_W", "err_rows",
+        "ratio", "cg_iterations", "cond_estimate", "error_exact", "err_vs_dense", "err_V",
+        "err_K", "err_W", "err_rows",
         "quantity", "exponent", "value", "failed", "load")
 
 
