@@ -129,3 +129,18 @@ def test_lanczos_condition_estimate():
         hm.solve_V(np.random.default_rng(0).standard_normal(hm.hmatrix("V").shape[0]))
         est = hm.solves[-1].counts["cond_estimate"]
         assert exact * 0.9 <= est <= exact * (1 + 1e-8), kind
+
+
+def test_warning_when_tol_too_coarse_for_the_conditioning():
+    """cond_2(V) >= the leaf blocks' eigenvalue ratio (Cauchy interlacing; Laplace p = 4,
+    N = 256: 736, measured); tol = 0.5 then leaves no digit: a UserWarning naming
+    tol; at tol = 1e-8 none."""
+    import warnings
+    for tol, warns in ((0.5, True), (1e-8, False)):
+        hm = operators(ScalingRun("laplace", 256, 4, "hmatrix", tol)).hm
+        with warnings.catch_warnings(record=True) as got:
+            warnings.simplefilter("always")
+            hm.preconditioner_V()
+        hits = [w for w in got if issubclass(w.category, UserWarning)
+                and "tol=" in str(w.message)]
+        assert bool(hits) == warns, tol

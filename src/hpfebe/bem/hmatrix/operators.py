@@ -24,6 +24,7 @@ formed.
 from __future__ import annotations
 
 import time
+import warnings
 from dataclasses import dataclass
 
 import numpy as np
@@ -264,7 +265,30 @@ class CompressedOperators:
                 L = self.geom[3][self.tree.order]
                 self._cache[kind] = Multilevel(H, self.tree, self.lay_W, L, self.d)
             self._cache[kind].cpu_s = time.process_time() - t0
+            self._check_conditioning(H)
         return self._cache[kind]
+
+    def _check_conditioning(self, H) -> None:
+        """Warn when ``tol`` is too coarse for the conditioning of V: the relative
+        error of V^{-1} b from a V perturbed by tol (relative) is up to cond_2(V) tol /
+        (1 - cond_2(V) tol), no digit once cond_2(V) tol >= 1.  cond_2(V) >= the lower
+        bound max_t lambda_max(V_tt) / min_t lambda_min(V_tt) over the leaf blocks
+        (principal sub-matrices: Cauchy interlacing); a leaf block that is not positive
+        definite is an error."""
+        lo, hi = np.inf, 0.0
+        for b in H.diag_blocks:                 # a loop over the leaf clusters
+            ev = np.linalg.eigvalsh(H.diagonal_block(int(b))[2])
+            lo, hi = min(lo, ev[0]), max(hi, ev[-1])
+        if lo <= 0.0:
+            raise np.linalg.LinAlgError(
+                f"the compressed V at tol={self.settings.tol:g} has a leaf block with "
+                f"eigenvalue {lo:.3e} <= 0: V is not positive definite")
+        kappa = hi / lo
+        if kappa * self.settings.tol >= 1.0:
+            warnings.warn(f"tol={self.settings.tol:g} is too coarse for V: cond_2(V) >= "
+                          f"{kappa:.3g}, so cond_2(V) * tol >= 1 and the solves with V "
+                          "(Psi, S_hat) may have no correct digit; use tol < "
+                          f"{1.0 / kappa:.1e}", UserWarning, stacklevel=3)
 
     def _project(self, psi):
         """psi - V^{-1} C (C^T V^{-1} C)^{-1} C^T psi (the constraint of P), if any."""
