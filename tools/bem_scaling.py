@@ -3,6 +3,8 @@
 
     python tools/bem_scaling.py [--quick] [--parts check,matvec,tol,scaling]
                                 [--cases laplace:1,laplace:4,lame:1,lame:2]
+                                [--methods dense,hmatrix] [--n-range lo:hi]
+                                [--preconditioner multilevel|jacobi]
                                 [--csv /tmp/bem_scaling.csv] [--max-dense-gb 2.5]
 
 Every measurement runs in a fresh subprocess (``--one``), one thread
@@ -20,9 +22,11 @@ Parts:
 * ``scaling``: time (assembly of V and B plus the solve for Psi) and memory against N,
   dense and compressed (tol 1e-8), Laplace p = 1 and 4, Lame p = 1 and 2; the fitted
   exponents over the target ranges (p = 1: N = 4096 ... 65536, p >= 2: 1024 ... 16384),
-  the compression ratio, the error against the exact data and, where dense ran, against
-  the dense solution; the dense error extrapolated to the largest N (fit over its last
-  three sizes) against the compressed error there.
+  the compression ratio, the CG iterations on V (``cg_iterations``, summed over the
+  solves) and CG's Lanczos estimate of cond(C^{-1} V) (``cond_estimate``), the error
+  against the exact data and, where dense ran, against the dense solution; the dense
+  error extrapolated to the largest N (fit over its last three sizes) against the
+  compressed error there.
 * ``tol``: error against dense and against the exact data as the tolerance varies.
 * ``matvec``: compressed V, K, W times a random vector against dense (relative 2-norm),
   Laplace and Lame, p = 1, 2, 4, at N = 4096, or the largest N whose dense matrix fits
@@ -88,6 +92,17 @@ def one_solve(spec: dict) -> dict:
     """One ScalingRun: its measurements (and psi saved to spec["psi_file"])."""
     from hpfebe.scenes import bem_scaling as bs
     run = bs.ScalingRun(spec["pde"], spec["N"], spec["p"], spec["compression"], spec["tol"])
+    if spec.get("preconditioner"):          # HMatrixSettings.preconditioner of the CG on V
+        from dataclasses import replace
+        make = bs.operators
+
+        def operators(r, _make=make):
+            op = _make(r)
+            if op.hm is not None:
+                op.hm.settings = replace(op.hm.settings,
+                                         preconditioner=spec["preconditioner"])
+            return op
+        bs.operators = operators
     _warm_up(run.pde, run.p, run.compression)
     rss0 = _status("VmRSS")
     t0, c0 = time.perf_counter(), time.process_time()
@@ -102,6 +117,8 @@ def one_solve(spec: dict) -> dict:
     if res.info is not None:
         out["max_rank"] = max(res.info[k]["max_rank"] for k in ("V", "K"))
         out["sampled_error"] = max(res.info[k]["sampled_error"] for k in ("V", "K"))
+        out["cg_iterations"] = int(sum(it for it, _ in res.info["solves"]))
+        out["cond_estimate"] = float(np.nanmax(res.info["cond_estimates"] or [np.nan]))
     return out
 
 
@@ -168,16 +185,20 @@ def _fit(rows, key, lo, hi):
     return fitted_rate([r["N"] for r in sel], [r[key] for r in sel]), len(sel)
 
 
-def part_scaling(sizes, tmp: Path, timeout: float, cases=CASES) -> tuple[list, list]:
+def part_scaling(sizes, tmp: Path, timeout: float, cases=CASES, methods=("dense", "hmatrix"),
+                 n_range=(0, 10**9), preconditioner=None) -> tuple[list, list]:
     rows, fits = [], []
     for pde, p in cases:
         dense_n, comp_n = sizes[(pde, p)]
         psis = {}
         for method, ns in (("dense", dense_n), ("hmatrix", comp_n)):
-            for N in ns:
+            if method not in methods:
+                continue
+            for N in (n for n in ns if n_range[0] <= n <= n_range[1]):
                 f = tmp / f"{pde}_{p}_{N}_{method}.npy"
                 spec = dict(pde=pde, p=p, N=N, tol=1e-8, psi_file=str(f),
-                            compression=None if method == "dense" else "hmatrix")
+                            compression=None if method == "dense" else "hmatrix",
+                            preconditioner=preconditioner)
                 r = dict(part="scaling", pde=pde, p=p, N=N, method=method, tol=1e-8,
                          load=_uptime(), **_spawn("solve", spec, timeout))
                 if "failed" not in r:
@@ -198,8 +219,11 @@ def _case_fits(pde, p, ok) -> list:
     out = []
     for method in ("dense", "hmatrix"):
         sub = [r for r in ok if r["method"] == method]
+        if not sub:                     # not run (--methods)
+            continue
         rng = (lo, hi) if method == "hmatrix" else (0, 10**9)
-        for key in ("total_s", "cpu_s", "run_mb", "storage_mb"):
+        keys = ("total_s", "cpu_s", "run_mb", "storage_mb")
+        for key in keys + (("cg_iterations",) if method == "hmatrix" else ()):
             e, n = _fit(sub, key, *rng)
             out.append(dict(part="fit", pde=pde, p=p, method=method, quantity=key,
                             exponent=e, points=n, N_lo=rng[0], N_hi=min(rng[1], 10**6)))
@@ -270,7 +294,8 @@ def part_check(Ns, timeout: float) -> list:
 
 
 SHOW = ("part", "pde", "p", "N", "method", "tol", "dof", "total_s", "cpu_s", "run_mb", "storage_mb",
-        "ratio", "error_exact", "err_vs_dense", "err_V", "err_K", "err_W", "err_rows",
+        "ratio", "cg_iterations", "cond_estimate", "error_exact", "err_vs_dense", "err_V",
+        "err_K", "err_W", "err_rows",
         "quantity", "exponent", "value", "failed", "load")
 
 
@@ -301,6 +326,12 @@ def main(argv=None) -> int:
     ap.add_argument("--cases", default=",".join(f"{c}:{p}" for c, p in CASES),
                     help="scaling part: pde:p pairs, e.g. laplace:1,lame:2")
     ap.add_argument("--timeout", type=float, default=1800.0)
+    ap.add_argument("--methods", default="dense,hmatrix",
+                    help="scaling part: dense, hmatrix or both")
+    ap.add_argument("--n-range", default="0:1000000000",
+                    help="scaling part: only the sizes N in lo:hi")
+    ap.add_argument("--preconditioner", default=None, choices=("multilevel", "jacobi"),
+                    help="of the CG on the compressed V (default: HMatrixSettings')")
     ap.add_argument("--one", nargs=2, metavar=("KIND", "SPEC"), help=argparse.SUPPRESS)
     a = ap.parse_args(argv)
     if a.one:
@@ -321,7 +352,9 @@ def main(argv=None) -> int:
                      tmp, a.timeout)
         if "scaling" in parts:
             cases = [(c, int(p)) for c, p in (x.split(":") for x in a.cases.split(","))]
-            _, fits = part_scaling(QUICK if a.quick else FULL, tmp, a.timeout, cases)
+            lo, hi = (int(v) for v in a.n_range.split(":"))
+            _, fits = part_scaling(QUICK if a.quick else FULL, tmp, a.timeout, cases,
+                                   a.methods.split(","), (lo, hi), a.preconditioner)
             print("\nfitted exponents (least squares in log-log):")
             for f in fits:
                 _print_row(f)

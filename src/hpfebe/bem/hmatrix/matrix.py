@@ -166,6 +166,7 @@ class HMatrix:
         if self.symmetric:      # the blocks on and above the diagonal
             near = near[tree.start[near[:, 0]] <= tree.start[near[:, 1]]]
             far = far[tree.start[far[:, 0]] < tree.start[far[:, 1]]]
+        self.near_clusters, self.far_clusters = near, far     # (t, s) cluster pairs
         nb = np.column_stack([tree.start[near[:, 0]], tree.stop[near[:, 0]],
                               tree.start[near[:, 1]], tree.stop[near[:, 1]]])
         self.near_rng = _dof_ranges(nb, test.off, trial.off)

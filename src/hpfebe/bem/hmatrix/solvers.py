@@ -66,7 +66,11 @@ def cg(apply_A, b: np.ndarray, precond=None, tol: float = 1e-10, maxiter: int = 
     columns of ``b`` at once (independent recursions sharing each matvec of a column
     block; a column stops when ||r_q|| <= tol ||b_q||, Euclidean).  ``apply_A``,
     ``precond``: callables on vectors or column blocks.  SolverInfo.residuals: the
-    largest relative residual of the active columns per iteration."""
+    largest relative residual of the active columns per iteration;
+    ``SolverInfo.counts["cond_estimate"]``: the Lanczos estimate of the condition number
+    of the preconditioned operator (the extreme eigenvalues of CG's tridiagonal matrix
+    T_k, Saad, "Iterative Methods", Sect. 6.7.3; a lower bound that tightens with k),
+    the largest over the columns."""
     b = np.asarray(b, dtype=float)
     one = b.ndim == 1
     B = b.reshape(b.shape[0], -1)
@@ -79,6 +83,7 @@ def cg(apply_A, b: np.ndarray, precond=None, tol: float = 1e-10, maxiter: int = 
     P = Z.copy()
     rz = np.einsum("ij,ij->j", R, Z)
     it = 0
+    alphas, betas = [], []          # per iteration, every column (NaN: inactive)
     while active.any() and it < maxiter:
         it += 1
         cols = np.flatnonzero(active)
@@ -89,6 +94,9 @@ def cg(apply_A, b: np.ndarray, precond=None, tol: float = 1e-10, maxiter: int = 
             info.reason = f"breakdown: p^T A p = {pAp.min():.3e} (A not SPD?)"
             return (X[:, 0] if one else X), info
         alpha = rz[cols] / pAp
+        alphas.append(np.full(B.shape[1], np.nan))
+        alphas[-1][cols] = alpha
+        betas.append(np.full(B.shape[1], np.nan))
         X[:, cols] += alpha * P[:, cols]
         R[:, cols] -= alpha * AP
         rel = np.linalg.norm(R[:, cols], axis=0) / bn[cols]
@@ -99,9 +107,11 @@ def cg(apply_A, b: np.ndarray, precond=None, tol: float = 1e-10, maxiter: int = 
             break
         Zc = precond(R[:, cols]) if precond is not None else R[:, cols]
         rz_new = np.einsum("ij,ij->j", R[:, cols], Zc)
+        betas[-1][cols] = rz_new / rz[cols]
         P[:, cols] = Zc + (rz_new / rz[cols]) * P[:, cols]
         rz[cols] = rz_new
     info.iterations = it
+    info.counts["cond_estimate"] = _lanczos_condition(np.array(alphas), np.array(betas))
     if not active.any():
         info.converged = True
         info.reason = f"converged: ||r|| / ||b|| <= {tol:.1e} for every column"
@@ -109,6 +119,24 @@ def cg(apply_A, b: np.ndarray, precond=None, tol: float = 1e-10, maxiter: int = 
         info.reason = (f"not converged in {maxiter} iterations: ||r|| / ||b|| = "
                        f"{info.residuals[-1]:.2e}")
     return (X[:, 0] if one else X), info
+
+
+def _lanczos_condition(alphas: np.ndarray, betas: np.ndarray) -> float:
+    """max over the columns of lambda_max / lambda_min of CG's Lanczos matrix: T_kk =
+    1/alpha_k + beta_{k-1}/alpha_{k-1}, T_{k,k-1} = sqrt(beta_{k-1})/alpha_{k-1}."""
+    best = float("nan")
+    for q in range(alphas.shape[1] if alphas.ndim == 2 else 0):     # a loop over columns
+        a = alphas[:, q][np.isfinite(alphas[:, q])]
+        if len(a) == 0:
+            continue
+        b = betas[:len(a) - 1, q]
+        diag = 1.0 / a
+        diag[1:] += b / a[:-1]
+        ev = (sla.eigvalsh_tridiagonal(diag, np.sqrt(b) / a[:-1]) if len(a) > 1
+              else diag)
+        if ev[0] > 0.0:
+            best = float(np.nanmax([best, ev[-1] / ev[0]]))
+    return best
 
 
 def gmres(apply_A, b: np.ndarray, precond=None, tol: float = 1e-10, restart: int = 100,
