@@ -43,7 +43,8 @@ def _figure(t: pd.DataFrame, refs: dict, repeats: int, max_k: int):
                "relative error of the contact force", "error vs time", title_size=9,
                legend=dict(fontsize=7))
     style_axes(axs[1], "h = 1/k", "relative error of the contact force",
-               "error vs mesh size (reference: Aitken of the 3 finest)", title_size=9, legend=dict(fontsize=7))
+               "error vs mesh size (reference: Aitken of the 3 finest)", title_size=9,
+               legend=dict(fontsize=7))
     return fig
 
 
@@ -103,7 +104,8 @@ def run(config: dict, quick: bool = False) -> list[ArtefactResult]:
               "different discrete problems, each error is against its own reference). "
               "Reference: Aitken extrapolation of the three finest meshes. Times: one "
               "solve including its set-up, the minimum of "
-              f"{prm.timing_repeats} repeats (k > {prm.repeat_max_k}: once; slowest/fastest up to {spread:.2f}); the "
+              f"{prm.timing_repeats} repeats (k > {prm.repeat_max_k}: once; slowest/fastest "
+              f"up to {spread:.2f}); the "
               f"untimed warm-up (numba) took {jit_s:.1f} s wall, {jit_cpu:.1f} s CPU. "
               "Mortar/penalty wall-time ratios per mesh: "
               + ", ".join(f"{x:.2f}" for x in ratio) + " (no claim on time is made).",
