@@ -16,9 +16,13 @@ the core (bodies, contact problems); experiments and tests import them.
 
 * :mod:`.mortar` - the model problem of Section 4.3.4 (Table 4.1, Figures 4.17-4.20): its
   meshes, initial gap, the mortar contact problem on them, the hp-adaptive run.
+* :mod:`.ch4_work_precision` - beyond the thesis (issue 28): Section 4.4's stamp force
+  on a mesh family, mortar and penalty, against the wall time, with its extrapolated
+  reference (exported as a module).
 """
 
-from . import adaptive_bem, adaptive_fefe, interface, penalty, plasticity, plasticity_fields
+from . import (adaptive_bem, adaptive_fefe, ch4_work_precision, interface, penalty, plasticity,
+               plasticity_fields)
 from .materials import E, H, MU_F, NU, PLANE, SIGMA_Y, FrictionalContactScene
 from .stamping import (STAMP_KINDS, STAMP_SOLVER, Snapshot, StampContact, StepRecord,
                        TouchResult, TouchSteps,
@@ -40,7 +44,7 @@ __all__ += ["E", "H", "MU_F", "NU", "PLANE", "SIGMA_Y", "FrictionalContactScene"
 __all__ += ["READINGS", "STAMP", "WORK", "X_POINT", "DtNReadings", "dtn_settings",
             "field_differences", "mortar_bodies", "penalty_bodies", "penalty_scene",
             "penetration_l2", "section44_scene", "tangential_share"]
-__all__ += ["adaptive_bem", "adaptive_fefe", "interface", "penalty",
+__all__ += ["adaptive_bem", "adaptive_fefe", "ch4_work_precision", "interface", "penalty",
             "plasticity", "plasticity_fields"]    # scenes exported as modules
 __all__ += ["ModelProblem", "adaptive_model_problem", "contact_from_meshes", "model_gap",
             "model_meshes", "model_problem", "mortar_contact_state"]
