@@ -94,6 +94,16 @@ def _times_blocks_kernel(A, D):
     return out
 
 
+@numba.njit(cache=True, inline="always")
+def _row_times_block(M, r, c, D, col):
+    """(M[r, 3c:3c+3] D[c])[col]: the 3-term sum of :func:`_times_blocks_kernel`, in its
+    order."""
+    acc = 0.0
+    for k in range(3):
+        acc += M[r, 3 * c + k] * D[c, k, col]
+    return acc
+
+
 @numba.njit(cache=True)
 def _plastic_blocks_kernel(M, pl, D, rows):
     """(MD, J) of the plastic cells ``pl``: MD = (M[:, p] blockdiag(D[pl]))[rows] (p the
@@ -107,23 +117,16 @@ def _plastic_blocks_kernel(M, pl, D, rows):
     for t in range(rows.size):
         r = rows[t]
         for j in range(n):
-            c3 = 3 * pl[j]
             for col in range(3):
-                acc = 0.0
-                for k in range(3):
-                    acc += M[r, c3 + k] * D[pl[j], k, col]
-                MD[t, 3 * j + col] = acc
+                MD[t, 3 * j + col] = _row_times_block(M, r, pl[j], D, col)
     J = np.empty((3 * n, 3 * n))
     for a in range(n):
         for i in range(3):
             r = 3 * pl[a] + i
             for j in range(n):
-                c3 = 3 * pl[j]
                 for col in range(3):
-                    acc = 0.0
-                    for k in range(3):
-                        acc += M[r, c3 + k] * D[pl[j], k, col]
-                    J[3 * a + i, 3 * j + col] = (1.0 if a == j and i == col else 0.0) - acc
+                    J[3 * a + i, 3 * j + col] = ((1.0 if a == j and i == col else 0.0)
+                                                 - _row_times_block(M, r, pl[j], D, col))
     return MD, J
 
 
