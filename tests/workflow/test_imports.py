@@ -63,3 +63,31 @@ def test_subpackage_all_resolves(name):
     assert len(set(names)) == len(names), f"hpfebe.{name}.__all__ has duplicates"
     missing = [n for n in names if not hasattr(mod, n)]
     assert not missing, f"hpfebe.{name}.__all__ names not defined: {missing}"
+
+
+def test_scenes_import_lazily():
+    """Issue 28: ``from hpfebe.scenes import interface`` (a Chapter 2 job's scene) imports
+    that scene alone, not the other scenes (adaptive_bem pulls in the adaptivity,
+    section44 the stamping scenes)."""
+    code = ("import sys\n"
+            "from hpfebe.scenes import interface\n"
+            "loaded = sorted(m for m in sys.modules if m.startswith('hpfebe.'))\n"
+            "print(' '.join(loaded))\n")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert out.returncode == 0, out.stderr
+    loaded = out.stdout.strip()
+    assert "hpfebe.scenes.interface" in loaded.split()
+    assert "hpfebe.scenes.adaptive_bem" not in loaded.split()
+    assert "hpfebe.scenes.section44" not in loaded.split()
+    assert "hpfebe.adaptivity" not in loaded
+
+
+def test_scenes_names_are_their_modules_objects():
+    from hpfebe import scenes
+    from hpfebe.scenes import materials, stamping
+
+    assert scenes.E is materials.E and scenes.touch is stamping.touch
+    assert scenes.penalty is importlib.import_module("hpfebe.scenes.penalty")
+    assert "section44_runs" in dir(scenes)
+    with pytest.raises(AttributeError, match="no_such_scene"):
+        scenes.no_such_scene  # noqa: B018

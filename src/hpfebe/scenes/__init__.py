@@ -19,41 +19,52 @@ the core (bodies, contact problems); experiments and tests import them.
 * :mod:`.ch4_work_precision` - beyond the thesis (issue 28): Section 4.4's stamp force
   on a mesh family, mortar and penalty, against the wall time, with its extrapolated
   reference (exported as a module).
+
+Every name is imported on first use (PEP 562, as in :mod:`hpfebe`): a job imports only
+the scenes it runs (issue 28: importing all of them cost a job about 1.2-3.4 s CPU, e.g.
+``adaptive_bem`` pulls in scikit-fem and the adaptivity for a Chapter 2 job that needs
+only :mod:`.interface`).  ``from hpfebe.scenes import X`` works as before.
 """
 
-from . import (adaptive_bem, adaptive_fefe, ch4_work_precision, interface, penalty, plasticity,
-               plasticity_fields)
-from .materials import E, H, MU_F, NU, PLANE, SIGMA_Y, FrictionalContactScene
-from .stamping import (STAMP_KINDS, STAMP_SOLVER, Snapshot, StampContact, StepRecord,
-                       TouchResult, TouchSteps,
-                       be_work_piece, curve_difference, element_areas, field_difference,
-                       lift_schedule, plastic_zone, stamp_body, stamp_interior, touch,
-                       touch_be, work_piece, zone_mismatch)
-from .mortar import (ModelProblem, adaptive_model_problem, contact_from_meshes, model_gap,
-                     model_meshes, model_problem, mortar_contact_state)
-from .section44 import (READINGS, STAMP, WORK, X_POINT, DtNReadings, dtn_settings,
-                        field_differences, mortar_bodies, penalty_bodies, penalty_scene,
-                        penetration_l2, section44_scene, tangential_share)
+from importlib import import_module
 
-__all__ = ["STAMP_KINDS", "STAMP_SOLVER", "Snapshot", "StampContact", "StepRecord",
-           "TouchResult", "TouchSteps",
-           "be_work_piece", "curve_difference", "element_areas", "field_difference",
-           "lift_schedule", "plastic_zone", "stamp_body", "stamp_interior", "touch",
-           "touch_be", "work_piece", "zone_mismatch"]
-__all__ += ["E", "H", "MU_F", "NU", "PLANE", "SIGMA_Y", "FrictionalContactScene"]
-__all__ += ["READINGS", "STAMP", "WORK", "X_POINT", "DtNReadings", "dtn_settings",
-            "field_differences", "mortar_bodies", "penalty_bodies", "penalty_scene",
-            "penetration_l2", "section44_scene", "tangential_share"]
-__all__ += ["adaptive_bem", "adaptive_fefe", "ch4_work_precision", "interface", "penalty",
-            "plasticity", "plasticity_fields"]    # scenes exported as modules
-__all__ += ["ModelProblem", "adaptive_model_problem", "contact_from_meshes", "model_gap",
-            "model_meshes", "model_problem", "mortar_contact_state"]
-from . import (mortar, mortar_readings, mortar_runs, section44,  # noqa: E402
-               section44_fields, section44_figures, section44_readings, section44_runs)
-__all__ += ["mortar", "mortar_readings", "mortar_runs", "section44", "section44_fields",
-            "section44_figures", "section44_readings",
-            "section44_runs"]    # scenes exported as modules
-from . import bem_scaling  # noqa: E402
-__all__ += ["bem_scaling"]    # issue 27: dense against compressed BEM, as a module
-from . import adaptive_bem_readings, interface_readings, penalty_readings  # noqa: E402
-__all__ += ["adaptive_bem_readings", "interface_readings", "penalty_readings"]  # Ch. 2-3
+#: scenes exported as modules (``from hpfebe.scenes import penalty``)
+_MODULES = ("adaptive_bem", "adaptive_fefe", "interface", "penalty", "plasticity",
+            "plasticity_fields",
+            "mortar", "mortar_readings", "mortar_runs", "section44", "section44_fields",
+            "section44_figures", "section44_readings", "section44_runs",
+            "bem_scaling",            # issue 27: dense against compressed BEM
+            "ch4_work_precision",     # issue 28: Chapter 4's work-precision figure
+            "adaptive_bem_readings", "interface_readings", "penalty_readings")  # Ch. 2-3
+
+#: public name -> the scene module that defines it
+_API = {name: module for module, names in {
+    "materials": ("E", "H", "MU_F", "NU", "PLANE", "SIGMA_Y", "FrictionalContactScene"),
+    "stamping": ("STAMP_KINDS", "STAMP_SOLVER", "Snapshot", "StampContact", "StepRecord",
+                 "TouchResult", "TouchSteps",
+                 "be_work_piece", "curve_difference", "element_areas", "field_difference",
+                 "lift_schedule", "plastic_zone", "stamp_body", "stamp_interior", "touch",
+                 "touch_be", "work_piece", "zone_mismatch"),
+    "mortar": ("ModelProblem", "adaptive_model_problem", "contact_from_meshes", "model_gap",
+               "model_meshes", "model_problem", "mortar_contact_state"),
+    "section44": ("READINGS", "STAMP", "WORK", "X_POINT", "DtNReadings", "dtn_settings",
+                  "field_differences", "mortar_bodies", "penalty_bodies", "penalty_scene",
+                  "penetration_l2", "section44_scene", "tangential_share"),
+}.items() for name in names}
+
+__all__ = [*_API, *_MODULES]
+
+
+def __getattr__(name: str):
+    if name in _MODULES:
+        value = import_module(f"{__name__}.{name}")
+    elif name in _API:
+        value = getattr(import_module(f"{__name__}.{_API[name]}"), name)
+    else:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    globals()[name] = value          # later look-ups skip __getattr__
+    return value
+
+
+def __dir__():
+    return sorted(set(globals()) | set(__all__))
