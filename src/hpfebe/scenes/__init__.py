@@ -49,7 +49,7 @@ from . import (mortar, mortar_readings, mortar_runs, section44,  # noqa: E402
 __all__ += ["mortar", "mortar_readings", "mortar_runs", "section44", "section44_fields",
             "section44_figures", "section44_readings",
             "section44_runs"]    # scenes exported as modules
-from . import bem_scaling  # noqa: E402
-__all__ += ["bem_scaling"]    # issue 27: dense against compressed BEM, as a module
+from . import bem_hertz, bem_scaling  # noqa: E402
+__all__ += ["bem_hertz", "bem_scaling"]    # issue 27: compressed BEM, as modules
 from . import adaptive_bem_readings, interface_readings, penalty_readings  # noqa: E402
 __all__ += ["adaptive_bem_readings", "interface_readings", "penalty_readings"]  # Ch. 2-3
