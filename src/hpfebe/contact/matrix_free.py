@@ -50,7 +50,7 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 from numba import njit
 
-from ..checks import array, choice, integer, real
+from ..checks import array, integer, real
 from ..solvers import SolverInfo
 
 __all__ = ["MixedPenaltyResult", "PenaltyP1", "near_field", "solve_penalty_mixed"]
@@ -251,8 +251,8 @@ def solve_penalty_mixed(bem, eps: float, gap, dirichlet_displacement=(0.0, 0.0),
                         load=None, contact_label: str = "C", dirichlet_label: str = "D",
                         tol: float = 1e-8, max_iter: int = 50,
                         gmres_tol: float | None = None, restart: int = 200,
-                        gmres_maxiter: int = 5, coarse: int | None = 16,
-                        krylov: str = "gmres", recycle=(30, 30)) -> MixedPenaltyResult:
+                        gmres_maxiter: int = 5, coarse: int | None = 16
+                        ) -> MixedPenaltyResult:
     """Penalty contact (3.45)-(3.46) of a compressed :class:`LameBEM` body (module doc).
 
     Parameters
@@ -278,7 +278,6 @@ def solve_penalty_mixed(bem, eps: float, gap, dirichlet_displacement=(0.0, 0.0),
     restart = integer("restart", restart, lo=1)
     gmres_maxiter = integer("gmres_maxiter", gmres_maxiter, lo=1)
     coarse = integer("coarse", coarse, lo=1, allow_none=True)
-    krylov = choice("krylov", krylov, ("gmres", "gcrotmk"))
     hm = getattr(bem, "hm", None)
     if hm is None:
         raise ValueError("bem: solve_penalty_mixed needs a LameBEM with "
@@ -339,7 +338,7 @@ def solve_penalty_mixed(bem, eps: float, gap, dirichlet_displacement=(0.0, 0.0),
         AZ0 = mixed0(Z.toarray())
     t_coarse = time.process_time() - t0
 
-    count, CU = [0], []
+    count = [0]
     U = np.zeros(n)
     U[fixed[: len(d)]], U[fixed[len(d):]] = ud[0], ud[1]
     psi = np.zeros(m)
@@ -392,13 +391,8 @@ def solve_penalty_mixed(bem, eps: float, gap, dirichlet_displacement=(0.0, 0.0),
         A = spla.LinearOperator((nf + m, nf + m), matvec=mixed, dtype=float)
         M = spla.LinearOperator((nf + m, nf + m), matvec=precond, dtype=float)
         count[0] = 0
-        if krylov == "gmres":
-            x, flag = spla.gmres(A, rhs, M=M, rtol=gtol, atol=0.0, restart=restart,
-                                 maxiter=gmres_maxiter, x0=precond(rhs))
-        else:       # GCROT(m, k): the recycled space carries over the Newton steps
-            x, flag = spla.gcrotmk(A, rhs, x0=precond(rhs), M=M, rtol=gtol, atol=0.0,
-                                   maxiter=gmres_maxiter * restart, m=recycle[0],
-                                   k=recycle[1], CU=CU, discard_C=True)
+        x, flag = spla.gmres(A, rhs, M=M, rtol=gtol, atol=0.0, restart=restart,
+                             maxiter=gmres_maxiter, x0=precond(rhs))
         t_gm += time.process_time() - t0
         gm_its.append(count[0])
         if flag != 0 or not np.all(np.isfinite(x)):
