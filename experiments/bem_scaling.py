@@ -19,11 +19,14 @@ import numpy as np
 import pandas as pd
 
 from hpfebe.analysis import fitted_rate
+from hpfebe.scenes import bem_hertz as bh
 from hpfebe.scenes import bem_scaling as bs
 from hpfebe.suite import (ArtefactResult, Claim, from_config, joint_claim, new_figure,
-                          progress, readable_log_ticks, style_axes, timed)
+                          progress, readable_log_ticks, select_scenes, style_axes, timed)
 
-ARTEFACTS = ("figure_bem_scaling",)
+ARTEFACTS = ("figure_bem_scaling", "figure_bem_hertz")
+#: independent computations: the scaling study; the Hertz contact showcase
+SCENES = {"scaling": ("figure_bem_scaling",), "hertz": ("figure_bem_hertz",)}
 CASES = (("laplace", 1), ("laplace", 4), ("lame", 1), ("lame", 2))
 ERROR_MATCH = 0.01        # compressed error against the exact data = dense one's +- 1 %
 FLOOR = 10.0              # dense errors below FLOOR x tol: the tolerance's floor shows
@@ -36,6 +39,16 @@ class Params:
     tol: float = 1e-8
     tols: tuple[float, ...] = (1e-4, 1e-6, 1e-8, 1e-10)
     tol_n: int = 1024                                   # Laplace p = 1 tolerance sweep
+
+
+@dataclass(frozen=True)
+class HertzParams:
+    sizes: tuple[int, ...] = (128, 256, 512)            # N of the half-disk, p = 1
+    delta: float = 5e-3                                 # top displacement
+    kappa: float = 1.0                                  # eps = kappa h / E*
+    tol: float = 1e-6                                   # H-matrices and Newton
+    dense_max_n: int = 256                              # dense check up to this N
+    rate_min: float = 0.5                               # claimed: error rates >= this
 
 
 def _exponents(t: pd.DataFrame, key: str) -> dict:
@@ -113,8 +126,9 @@ def _figure(scaling: pd.DataFrame, tols: pd.DataFrame):
     return fig
 
 
-def run(config: dict, quick: bool = False) -> list[ArtefactResult]:
-    prm = from_config(Params, config, scene="bem_scaling")
+def _scaling(config: dict) -> list[ArtefactResult]:
+    prm = from_config(Params, {k: v for k, v in (config or {}).items() if k != "hertz"},
+                      scene="bem_scaling")
     jit_s = timed(lambda: [bs.solve(bs.ScalingRun(pde, 16, p, c)) for pde, p in CASES
                            for c in (None, "hmatrix")])[1]     # compile / load the cache
     rows = []
@@ -134,3 +148,74 @@ def run(config: dict, quick: bool = False) -> list[ArtefactResult]:
                            claims=_claims(scaling, tols, prm), notes=notes,
                            meta=dict(jit_s=round(jit_s, 3), max_dof=int(table.dof.max()),
                                      allow_nan_columns=["tol", "err_vs_dense"]))]
+
+
+def _hertz(config: dict) -> list[ArtefactResult]:
+    """Hertz contact of the half-disk (:mod:`hpfebe.scenes.bem_hertz`): a and p0 against
+    Hertz's as N grows, the fitted rates in h, the compressed against the dense solve at
+    small N and the pressure profile of the finest mesh against Hertz's ellipse."""
+    prm = from_config(HertzParams, (config or {}).get("hertz"), scene="bem_scaling.hertz")
+    jit_s = timed(lambda: bh.solve(bh.HertzRun(32, prm.delta, prm.kappa, prm.tol)))[1]
+    rows, last = [], None
+    for n in progress(prm.sizes, desc="hertz N"):
+        run = bh.HertzRun(n, prm.delta, prm.kappa, prm.tol)
+        last = bh.solve(run)
+        row = {k: v for k, v in last.items() if k not in ("U", "profile")}
+        if n <= prm.dense_max_n:
+            dense = bh.solve(run, compression=None)
+            row["diff_dense"] = float(np.linalg.norm(last["U"] - dense["U"])
+                                      / np.linalg.norm(dense["U"]))
+        rows.append(row)
+    t = pd.DataFrame(rows)
+    ra = fitted_rate(t.h, t.err_a, last=min(3, len(t)))
+    rp = fitted_rate(t.h, t.err_p0, last=min(3, len(t)))
+    checked = t.dropna(subset=["diff_dense"]) if "diff_dense" in t else t.iloc[:0]
+    claims = [
+        Claim("Every compressed Newton solve converged (backward errors of (U, psi) "
+              f"<= tol = {prm.tol:g})", bool(t.converged.all()),
+              f"largest backward error {t.backward_error.max():.2e}", kind="beyond"),
+        Claim(f"At N <= {prm.dense_max_n} the compressed solution equals the dense "
+              f"penalty solve to the tolerance {prm.tol:g}",
+              bool(len(checked) and (checked.diff_dense <= prm.tol).all()) if len(checked)
+              else None, "; ".join(f"N={int(r.N)}: {r.diff_dense:.2e}"
+                                   for r in checked.itertuples()) or "no dense run",
+              kind="beyond"),
+        Claim(f"The errors of a and p0 against Hertz fall with h at a rate >= "
+              f"{prm.rate_min:g} (fitted over the last three N)",
+              bool(ra >= prm.rate_min and rp >= prm.rate_min),
+              f"rate of a {ra:.2f}, of p0 {rp:.2f}", kind="beyond")]
+    fig, axes = new_figure((10.0, 4.0), 1, 2, layout="constrained")
+    axes[0].loglog(t.N, t.err_a, "o-", label=f"a (rate in h {ra:.2f})")
+    axes[0].loglog(t.N, t.err_p0, "s-", label=f"p0 (rate in h {rp:.2f})")
+    axes[0].loglog(t.N, t.err_a.iloc[0] * t.N.iloc[0] / t.N, "k:", label="O(h)")
+    readable_log_ticks(axes[0].xaxis)
+    style_axes(axes[0], "N", "relative error against Hertz", "Hertz: a, p0",
+               legend=dict(fontsize=7))
+    x, p = last["profile"]
+    o = np.argsort(x)
+    aH, p0H = last["a_hertz"], last["p0_hertz"]
+    xs = np.linspace(-aH, aH, 401)
+    axes[1].plot(x[o], p[o], ".", ms=3, label=f"penalty BEM, N={int(last['N'])}")
+    axes[1].plot(xs, p0H * np.sqrt(np.clip(1 - (xs / aH) ** 2, 0, None)), "k-",
+                 label="Hertz")
+    axes[1].set_xlim(-2 * aH, 2 * aH)
+    style_axes(axes[1], "x", "contact pressure", "pressure profile",
+               legend=dict(fontsize=7))
+    notes = ("Beyond the thesis (issue 27's showcase). " + bh.__doc__.split("\n\n")[1]
+             .replace("\n", " ") + f" delta = {prm.delta:g}, kappa = {prm.kappa:g}, "
+             f"tol = {prm.tol:g}, N = {list(prm.sizes)}; rates fitted over the last three "
+             "N. The N = 16384 run: python tools/bem_hertz.py.")
+    t = t.drop(columns=["reason"])
+    return [ArtefactResult(name="figure_bem_hertz", table=t, figure=fig, keys=("N",),
+                           claims=claims, notes=notes,
+                           meta=dict(jit_s=round(jit_s, 3),
+                                     allow_nan_columns=["diff_dense", "backward_error"]))]
+
+
+SCENE_RUNS = {"scaling": _scaling, "hertz": _hertz}
+
+
+def run(config: dict, quick: bool = False, scenes=None) -> list[ArtefactResult]:
+    """The artefacts of the scenes asked for (None: all)."""
+    names = select_scenes(SCENES, scenes, "bem_scaling")
+    return [r for name in names for r in SCENE_RUNS[name](config)]

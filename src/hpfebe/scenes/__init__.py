@@ -34,6 +34,7 @@ _MODULES = ("adaptive_bem", "adaptive_fefe", "interface", "penalty", "plasticity
             "mortar", "mortar_readings", "mortar_runs", "section44", "section44_fields",
             "section44_figures", "section44_readings", "section44_runs",
             "bem_scaling",            # issue 27: dense against compressed BEM
+            "bem_hertz",              # issue 27: Hertz contact on the compressed operators
             "ch4_work_precision",     # issue 28: Chapter 4's work-precision figure
             "adaptive_bem_readings", "interface_readings", "penalty_readings")  # Ch. 2-3
 

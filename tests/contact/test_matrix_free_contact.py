@@ -1,0 +1,73 @@
+"""The mixed (U, psi) penalty solver on the compressed Lame operators
+(hpfebe.contact.matrix_free): agreement with the dense penalty solve, reported
+non-convergence, refused input."""
+
+import numpy as np
+import pytest
+
+from hpfebe.bem import LameBEM
+from hpfebe.contact.matrix_free import solve_penalty_mixed
+from hpfebe.scenes import bem_hertz as bh
+from hpfebe.scenes.materials import E, NU
+
+
+def _bem(n, compression="hmatrix", tol=1e-6):
+    return LameBEM(bh.half_disk(n), E, NU, zero_force=False, compression=compression,
+                   tol=tol)
+
+
+@pytest.mark.parametrize("tol", [1e-6, 1e-8])
+def test_agrees_with_dense_penalty_solve(tol):
+    run = bh.HertzRun(128, tol=tol)
+    comp = bh.solve(run)
+    dense = bh.solve(run, compression=None)
+    assert comp["converged"] and dense["converged"]
+    assert comp["backward_error"] <= tol
+    # the compressed operators are accurate to tol: so is the solution
+    diff = np.linalg.norm(comp["U"] - dense["U"]) / np.linalg.norm(dense["U"])
+    assert diff <= tol
+    assert comp["a"] == pytest.approx(dense["a"], rel=10 * tol)
+
+
+def test_gmres_and_deflation_variants_agree():
+    bem = _bem(64)
+    run = bh.HertzRun(64)
+    a = solve_penalty_mixed(bem, run.eps, bh.gap, (0.0, -run.delta), coarse=None)
+    b = solve_penalty_mixed(bem, run.eps, bh.gap, (0.0, -run.delta), coarse=8)
+    assert a.converged and b.converged
+    assert np.linalg.norm(a.U - b.U) <= 1e-6 * np.linalg.norm(a.U)
+
+
+def test_non_convergence_is_reported_with_a_reason():
+    bem = _bem(64)
+    run = bh.HertzRun(64)
+    res = solve_penalty_mixed(bem, run.eps, bh.gap, (0.0, -run.delta), max_iter=1)
+    assert not res.converged
+    assert res.reason.startswith("max_iter") and "backward errors" in res.reason
+    res = solve_penalty_mixed(bem, run.eps, bh.gap, (0.0, -run.delta), restart=2,
+                              gmres_maxiter=1, gmres_tol=1e-12)
+    assert not res.converged and res.reason.startswith("gmres did not converge")
+
+
+def test_bad_input_names_the_parameter():
+    bem = _bem(32)
+    with pytest.raises(ValueError, match="eps"):
+        solve_penalty_mixed(bem, 0.0, bh.gap, (0.0, -1e-3))
+    with pytest.raises(ValueError, match="eps"):
+        solve_penalty_mixed(bem, -1.0, bh.gap, (0.0, -1e-3))
+    for tol in (0.0, 1.0, -1e-3, np.nan):
+        with pytest.raises(ValueError, match="tol"):
+            solve_penalty_mixed(bem, 1e-6, bh.gap, (0.0, -1e-3), tol=tol)
+    with pytest.raises(ValueError, match="dirichlet_displacement"):
+        solve_penalty_mixed(bem, 1e-6, bh.gap, (0.0, np.nan))
+    with pytest.raises(ValueError, match="compression"):
+        solve_penalty_mixed(_bem(32, compression=None), 1e-6, bh.gap, (0.0, -1e-3))
+    with pytest.raises(ValueError, match="zero_force"):
+        solve_penalty_mixed(LameBEM(bh.half_disk(32), E, NU, compression="hmatrix"),
+                            1e-6, bh.gap, (0.0, -1e-3))
+    with pytest.raises(ValueError, match="contact_label"):
+        solve_penalty_mixed(bem, 1e-6, bh.gap, (0.0, -1e-3), contact_label="X")
+    with pytest.raises(ValueError, match="delta"):
+        bh.HertzRun(64, delta=-1e-3)
+    with pytest.raises(ValueError, match="delta"):
+        bh.HertzRun(64, delta=0.0)
