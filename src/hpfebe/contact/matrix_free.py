@@ -247,6 +247,154 @@ class MixedPenaltyResult:
     n_active: int = 0
 
 
+class _MixedSystem:
+    """The operators of :func:`solve_penalty_mixed`: checked inputs, the free dofs, the
+    near-field block matrix (built once), the coarse space of the deflation with its
+    products A0 Z (once), the mixed operator and each Newton step's preconditioner."""
+
+    def __init__(self, bem, gap, dirichlet_displacement, load, contact_label,
+                 dirichlet_label, coarse):
+        hm = getattr(bem, "hm", None)
+        if hm is None:
+            raise ValueError("bem: solve_penalty_mixed needs a LameBEM with "
+                             "compression='hmatrix' (got the dense path)")
+        if getattr(bem, "d", 0) != 2:
+            raise ValueError("bem must be a LameBEM (vector traces)")
+        if bem.constrained:
+            raise ValueError("bem: zero_force must be False (the mixed form uses P = V^-1)")
+        mesh = bem.mesh
+        self.ud = array("dirichlet_displacement", dirichlet_displacement, shape=(2,))
+        ce = np.flatnonzero(mesh.where(contact_label))
+        if ce.size == 0:
+            raise ValueError(f"contact_label {contact_label!r}: no element carries this "
+                             "label")
+        if not np.any(mesh.where(dirichlet_label)):
+            raise ValueError(f"dirichlet_label {dirichlet_label!r}: no element carries "
+                             "this label (the rigid modes need a Dirichlet side)")
+        n = self.n = 2 * bem.V_space.ndof
+        d = self.d = np.asarray(bem.V_space.dofs_on(dirichlet_label), np.int64)
+        self.fixed = np.concatenate([2 * d, 2 * d + 1])
+        self.free = np.setdiff1d(np.arange(n), self.fixed)
+        self.f = np.zeros(n) if load is None else array("load", load, shape=(n,))
+        self.pen = PenaltyP1(mesh, bem.V_space, ce, gap)
+        self.W, self.B, self.V = hm.W, hm.B, hm.V
+        m = self.m = self.V.shape[0]
+        self.nf = len(self.free)
+        self.count = 0
+        # near-field block matrix (global numbering), built once
+        t0 = time.process_time()
+        Pw = _perm_matrix(hm.perm_W, m)
+        self.Vn = (Pw @ near_field(hm.hmatrix("V")) @ Pw.T).tocsr()
+        Bn = (Pw @ near_field(hm.hmatrix("K")) @ hm.S + 0.5 * bem.M).tocsr()
+        Wn = (hm.S.T @ near_field(hm.hmatrix("W")) @ hm.S).tocsr()
+        self.Wff, self.Bf = Wn[self.free][:, self.free], Bn[:, self.free]
+        self.t_near = time.process_time() - t0
+        # coarse space of the deflated preconditioner: A0 Z once (H-matrix products)
+        t0 = time.process_time()
+        self.Z = None
+        if coarse is not None:
+            Zu, Zp = coarse_space(mesh, bem.V_space, bem.W_space, coarse)
+            Zuf = Zu[self.free]
+            self.Zuf = Zuf[:, np.flatnonzero(np.diff(Zuf.tocsc().indptr))]  # not in Gamma_D
+            self.Z = sp.block_diag([self.Zuf, Zp], format="csr")
+            self.AZ0 = self.mixed0(self.Z.toarray())
+        self.t_coarse = time.process_time() - t0
+
+    def start(self) -> np.ndarray:
+        """U = 0 but the prescribed translation on Gamma_D."""
+        U = np.zeros(self.n)
+        U[self.fixed[: len(self.d)]], U[self.fixed[len(self.d):]] = self.ud
+        return U
+
+    def mixed0(self, x):
+        """The mixed matrix without C_eps on a vector or the columns of a matrix."""
+        x = np.asarray(x, float)
+        du = np.zeros((self.n,) + x.shape[1:])
+        du[self.free] = x[:self.nf]
+        dp = x[self.nf:]
+        y1 = self.W @ du + self.B.T @ dp
+        return np.concatenate([y1[self.free], self.B @ du - self.V @ dp])
+
+    def mixed(self, x, Cff):
+        """The mixed matrix with the penalty Jacobian C_eps (free dofs) on x."""
+        self.count += 1
+        y = self.mixed0(x)
+        y[:self.nf] += Cff @ x[:self.nf]
+        return y
+
+    def residuals(self, U, psi, eps):
+        """``((be1, be2), S_hat U, r1, r2, J_c)``: the residuals of both equations (r1 on
+        the free dofs), their backward errors (module doc) and the penalty energy, from
+        fresh products with the compressed operators."""
+        WU, Btp, BU, Vp = self.W @ U, self.B.T @ psi, self.B @ U, self.V @ psi
+        energy_c, fc, _ = self.pen.terms(U, eps, self.n)
+        Su = WU + Btp
+        r1 = (Su + fc - self.f)[self.free]
+        r2 = BU - Vp
+        be1 = np.linalg.norm(r1) / max(float(np.linalg.norm(self.f[self.free]))
+                                       + np.linalg.norm(Su[self.free])
+                                       + np.linalg.norm(fc[self.free]), 1e-300)
+        be2 = np.linalg.norm(r2) / max(np.linalg.norm(BU) + np.linalg.norm(Vp), 1e-300)
+        return (float(be1), float(be2)), Su, r1, r2, energy_c
+
+    def step(self, r1, r2, Cff, precond, gtol, restart, maxiter):
+        """``(du, dp, failure)``: the Newton step by preconditioned GMRES (its products
+        counted in ``self.count``); ``failure`` a reason, or "" when GMRES converged."""
+        nf, m = self.nf, self.m
+        rhs = -np.concatenate([r1, r2])
+        A = spla.LinearOperator((nf + m, nf + m), matvec=lambda x: self.mixed(x, Cff),
+                                dtype=float)
+        M = spla.LinearOperator((nf + m, nf + m), matvec=precond, dtype=float)
+        self.count = 0
+        x, flag = spla.gmres(A, rhs, M=M, rtol=gtol, atol=0.0, restart=restart,
+                             maxiter=maxiter, x0=precond(rhs))
+        failure = ""
+        if flag != 0 or not np.all(np.isfinite(x)):
+            rel = np.linalg.norm(rhs - A @ x) / np.linalg.norm(rhs)
+            failure = (f"flag {flag}, {self.count} iterations: ||r|| / ||b|| = {rel:.1e} > "
+                       f"gmres_tol = {gtol:.1e}")
+        du = np.zeros(self.n)
+        du[self.free] = x[:nf]
+        return du, x[nf:], failure
+
+    def preconditioner(self, Cff):
+        """The near-field LU of [[W + C_eps, B^T], [B, -V]], deflated by the coarse space
+        (ADEF1: Z w + M0^{-1} (r - A Z w), w = (Z^T A Z)^{-1} Z^T r)."""
+        P = sp.bmat([[self.Wff + Cff, self.Bf.T], [self.Bf, -self.Vn]], format="csc")
+        lu = spla.splu(P, permc_spec="COLAMD")
+        if self.Z is None:
+            return lu.solve
+        Z, AZ = self.Z, self.AZ0.copy()
+        AZ[:self.nf, :self.Zuf.shape[1]] += (Cff @ self.Zuf).toarray()
+        Ac = sla.lu_factor(Z.T @ AZ)
+
+        def precond(r):
+            w = sla.lu_solve(Ac, Z.T @ r)
+            return Z @ w + lu.solve(r - AZ @ w)
+        return precond
+
+
+def _armijo(sysm: _MixedSystem, U, du, dp, Su, energy_c, r1, eps):
+    """``(t, None)``: the Armijo step on the energy J along (du, dp) (module doc: no extra
+    operator product beyond S_hat du), or ``(None, why)``."""
+    f, n = sysm.f, sysm.n
+    Sdu = sysm.W @ du + sysm.B.T @ dp
+    J0 = 0.5 * U @ Su + energy_c - f @ U
+    slope = float(du[sysm.free] @ r1)
+    if slope >= 0.0:
+        return None, (f"not a descent direction (slope {slope:.2e}): GMRES step too "
+                      "inaccurate")
+    t = 1.0
+    while True:
+        Ut = U + t * du
+        Jt = (0.5 * Ut @ (Su + t * Sdu) + sysm.pen.terms(Ut, eps, n)[0] - f @ Ut)
+        if Jt <= J0 + ARMIJO * t * slope or abs(Jt - J0) <= 1e-15 * abs(J0):
+            return t, None
+        t *= 0.5
+        if t < MIN_STEP:
+            return None, "line search failed"
+
+
 def solve_penalty_mixed(bem, eps: float, gap, dirichlet_displacement=(0.0, 0.0),
                         load=None, contact_label: str = "C", dirichlet_label: str = "D",
                         tol: float = 1e-8, max_iter: int = 50,
@@ -278,86 +426,17 @@ def solve_penalty_mixed(bem, eps: float, gap, dirichlet_displacement=(0.0, 0.0),
     restart = integer("restart", restart, lo=1)
     gmres_maxiter = integer("gmres_maxiter", gmres_maxiter, lo=1)
     coarse = integer("coarse", coarse, lo=1, allow_none=True)
-    hm = getattr(bem, "hm", None)
-    if hm is None:
-        raise ValueError("bem: solve_penalty_mixed needs a LameBEM with "
-                         "compression='hmatrix' (got the dense path)")
-    if getattr(bem, "d", 0) != 2:
-        raise ValueError("bem must be a LameBEM (vector traces)")
-    if bem.constrained:
-        raise ValueError("bem: zero_force must be False (the mixed form uses P = V^-1)")
-    mesh = bem.mesh
-    ud = array("dirichlet_displacement", dirichlet_displacement, shape=(2,))
-    ce = np.flatnonzero(mesh.where(contact_label))
-    if ce.size == 0:
-        raise ValueError(f"contact_label {contact_label!r}: no element carries this label")
-    if not np.any(mesh.where(dirichlet_label)):
-        raise ValueError(f"dirichlet_label {dirichlet_label!r}: no element carries this "
-                         "label (the rigid modes need a Dirichlet side)")
-    n = 2 * bem.V_space.ndof
-    d = bem.V_space.dofs_on(dirichlet_label)
-    fixed = np.concatenate([2 * np.asarray(d, np.int64), 2 * np.asarray(d, np.int64) + 1])
-    free = np.setdiff1d(np.arange(n), fixed)
-    f = np.zeros(n) if load is None else array("load", load, shape=(n,))
-    pen = PenaltyP1(mesh, bem.V_space, ce, gap)
-
-    W, B, V = hm.W, hm.B, hm.V
-    m = V.shape[0]
-    # ---- near-field block matrix (global numbering), built once
-    t0 = time.process_time()
-    Pw = _perm_matrix(hm.perm_W, m)
-    Vn = (Pw @ near_field(hm.hmatrix("V")) @ Pw.T).tocsr()
-    Bn = (Pw @ near_field(hm.hmatrix("K")) @ hm.S + 0.5 * bem.M).tocsr()
-    Wn = (hm.S.T @ near_field(hm.hmatrix("W")) @ hm.S).tocsr()
-    Wff, Bf = Wn[free][:, free], Bn[:, free]
-    t_near = time.process_time() - t0
-    nf = len(free)
-
-    def mixed0(x):
-        """The mixed matrix without C_eps on a vector or the columns of a matrix."""
-        x = np.asarray(x, float)
-        du = np.zeros((n,) + x.shape[1:])
-        du[free] = x[:nf]
-        dp = x[nf:]
-        y1 = W @ du + B.T @ dp
-        return np.concatenate([y1[free], B @ du - V @ dp])
-
-    def mixed(x):
-        count[0] += 1
-        y = mixed0(x)
-        y[:nf] += Cff @ x[:nf]
-        return y
-
-    # ---- coarse space of the deflated preconditioner: A0 Z once (H-matrix products)
-    t0 = time.process_time()
-    if coarse is not None:
-        Zu, Zp = coarse_space(mesh, bem.V_space, bem.W_space, coarse)
-        Zuf = Zu[free]
-        Zuf = Zuf[:, np.flatnonzero(np.diff(Zuf.tocsc().indptr))]   # hats inside Gamma_D
-        Z = sp.block_diag([Zuf, Zp], format="csr")
-        AZ0 = mixed0(Z.toarray())
-    t_coarse = time.process_time() - t0
-
-    count = [0]
-    U = np.zeros(n)
-    U[fixed[: len(d)]], U[fixed[len(d):]] = ud[0], ud[1]
-    psi = np.zeros(m)
+    sysm = _MixedSystem(bem, gap, dirichlet_displacement, load, contact_label,
+                        dirichlet_label, coarse)
+    n, free, f, pen = sysm.n, sysm.free, sysm.f, sysm.pen
+    U, psi = sysm.start(), np.zeros(sysm.m)
     info = SolverInfo(converged=False, reason="")
     gm_its, t_lu, t_gm = [], 0.0, 0.0
-    Su = None
-    fnorm = float(np.linalg.norm(f[free]))
     bes = (np.inf, np.inf)
     for it in range(max_iter + 1):
         # ---- residuals and backward errors of (U, psi): fresh operator products
-        WU, Btp, BU, Vp = W @ U, B.T @ psi, B @ U, V @ psi
-        energy_c, fc, act = pen.terms(U, eps, n)
-        Su = WU + Btp
-        r1 = (Su + fc - f)[free]
-        r2 = BU - Vp
-        be1 = np.linalg.norm(r1) / max(fnorm + np.linalg.norm(Su[free])
-                                       + np.linalg.norm(fc[free]), 1e-300)
-        be2 = np.linalg.norm(r2) / max(np.linalg.norm(BU) + np.linalg.norm(Vp), 1e-300)
-        bes = (float(be1), float(be2))
+        bes, Su, r1, r2, energy_c = sysm.residuals(U, psi, eps)
+        be1, be2 = bes
         info.residuals.append(max(bes))
         info.merits.append(0.5 * U @ Su + energy_c - f @ U)
         if max(bes) <= tol:
@@ -373,64 +452,28 @@ def solve_penalty_mixed(bem, eps: float, gap, dirichlet_displacement=(0.0, 0.0),
         C = pen.jacobian(U, eps, n)
         Cff = C[free][:, free]
         t0 = time.process_time()
-        P = sp.bmat([[Wff + Cff, Bf.T], [Bf, -Vn]], format="csc")
-        lu = spla.splu(P, permc_spec="COLAMD")
-        if coarse is None:
-            precond = lu.solve
-        else:       # ADEF1: Z w + M0^{-1} (r - A Z w), w = (Z^T A Z)^{-1} Z^T r
-            AZ = AZ0.copy()
-            AZ[:nf, :Zuf.shape[1]] += (Cff @ Zuf).toarray()
-            Ac = sla.lu_factor(Z.T @ AZ)
-
-            def precond(r, lu=lu, AZ=AZ, Ac=Ac):
-                w = sla.lu_solve(Ac, Z.T @ r)
-                return Z @ w + lu.solve(r - AZ @ w)
+        precond = sysm.preconditioner(Cff)
         t_lu += time.process_time() - t0
         t0 = time.process_time()
-        rhs = -np.concatenate([r1, r2])
-        A = spla.LinearOperator((nf + m, nf + m), matvec=mixed, dtype=float)
-        M = spla.LinearOperator((nf + m, nf + m), matvec=precond, dtype=float)
-        count[0] = 0
-        x, flag = spla.gmres(A, rhs, M=M, rtol=gtol, atol=0.0, restart=restart,
-                             maxiter=gmres_maxiter, x0=precond(rhs))
+        du, dp, failure = sysm.step(r1, r2, Cff, precond, gtol, restart, gmres_maxiter)
         t_gm += time.process_time() - t0
-        gm_its.append(count[0])
-        if flag != 0 or not np.all(np.isfinite(x)):
-            rel = np.linalg.norm(rhs - A @ x) / np.linalg.norm(rhs)
-            info.reason = (f"gmres did not converge at Newton step {it + 1} (flag {flag}, "
-                           f"{count[0]} iterations): ||r|| / ||b|| = {rel:.1e} > "
-                           f"gmres_tol = {gtol:.1e}")
+        gm_its.append(sysm.count)
+        if failure:
+            info.reason = f"gmres did not converge at Newton step {it + 1} ({failure})"
             break
-        du = np.zeros(n)
-        du[free] = x[:nf]
-        dp = x[nf:]
         # ---- step length: full step first; then Armijo on the energy (module doc)
         t = 1.0
         if it > 0:
-            Sdu = W @ du + B.T @ dp
-            J0 = 0.5 * U @ Su + energy_c - f @ U
-            slope = float(du[free] @ r1)
-            if slope >= 0.0:
-                info.reason = (f"not a descent direction at Newton step {it + 1} (slope "
-                               f"{slope:.2e}): GMRES step too inaccurate")
-                break
-            while True:
-                Ut = U + t * du
-                Jt = (0.5 * Ut @ (Su + t * Sdu) + pen.terms(Ut, eps, n)[0] - f @ Ut)
-                if Jt <= J0 + ARMIJO * t * slope or abs(Jt - J0) <= 1e-15 * abs(J0):
-                    break
-                t *= 0.5
-                if t < MIN_STEP:
-                    break
-            if t < MIN_STEP:
-                info.reason = f"line search failed at Newton step {it + 1}"
+            t, why = _armijo(sysm, U, du, dp, Su, energy_c, r1, eps)
+            if t is None:
+                info.reason = f"{why} at Newton step {it + 1}"
                 break
         info.step_lengths.append(t)
         U = U + t * du
         psi = psi + t * dp
         info.iterations = it + 1
     info.backward_error = max(bes)
-    times = dict(near_s=t_near, coarse_s=t_coarse, lu_s=t_lu, gmres_s=t_gm,
+    times = dict(near_s=sysm.t_near, coarse_s=sysm.t_coarse, lu_s=t_lu, gmres_s=t_gm,
                  total_s=time.process_time() - t_all)
     return MixedPenaltyResult(U=U, psi=psi, converged=info.converged, reason=info.reason,
                               eps=eps, iterations=info.iterations, info=info,
