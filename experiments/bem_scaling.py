@@ -17,6 +17,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 import pandas as pd
+from matplotlib.ticker import MaxNLocator
 
 from hpfebe.analysis import fitted_rate
 from hpfebe.scenes import bem_hertz as bh
@@ -199,6 +200,7 @@ def _hertz(config: dict) -> list[ArtefactResult]:
     axes[1].plot(xs, p0H * np.sqrt(np.clip(1 - (xs / aH) ** 2, 0, None)), "k-",
                  label="Hertz")
     axes[1].set_xlim(-2 * aH, 2 * aH)
+    axes[1].xaxis.set_major_locator(MaxNLocator(5))     # readable tick labels
     style_axes(axes[1], "x", "contact pressure", "pressure profile",
                legend=dict(fontsize=7))
     notes = ("Beyond the thesis (issue 27's showcase). " + bh.__doc__.split("\n\n")[1]
