@@ -22,22 +22,12 @@ from hpfebe.contact.loading import LoadSteps
 from hpfebe.scenes.materials import E, H, NU, SIGMA_Y
 from hpfebe.scenes.stamping import be_work_piece, stamp_body
 
+from .test_ch4_newton import _stepper   # one Newton step, the cached state moved away
+
 H_BEBE = 0.4
 WORK = (-2.0, 2.0, -3.0, -1.0)
 STAMP = (-1.0, 1.0, -1.0, 0.0)
 LIFT = 4.2e-4                  # the first increment of Example 2 (4.2e-3 in 10)
-
-
-def _stepper(problem, x):
-    """One Newton step, alternating between x and a copy moved at round-off level (the
-    BE body caches its state at the last u: every call computes it anew)."""
-    xs, k = (x, x * (1.0 + 1e-13)), [0]
-
-    def step():
-        k[0] += 1
-        return problem.step(problem.evaluate(xs[k[0] % 2]))
-
-    return step
 
 
 def test_bench_newton_step_bebe(benchmark):
