@@ -94,6 +94,13 @@ def _plastic(steps: dict) -> None:
     body = ElastoPlasticFE(rectangle_mesh(0.0, 1.0, 0.0, 1.0, 2, 2),
                            J2Material(1.0, 0.3, 1.0, 0.1))
     body.internal_force(np.zeros(body.ndofs))
+    # a plastic state (every point past yield: strains of 10 against sigma_Y / E = 1): the
+    # tangent kernels (_tangent_kernel, tangent_factors), compiled inside Example 2's job
+    # before, and after a commit the committed force (_force_kernel)
+    u = 10.0 * body.dof_coordinates()[:, 0]
+    body.internal_force(u)
+    body.commit(u)
+    body.committed_force()
     steps["plasticity"] = time.perf_counter() - t
 
     # the BE work piece (Example 2's BE/BE runs): the cell checks, containment, the
