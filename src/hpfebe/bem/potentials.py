@@ -249,6 +249,20 @@ def _element_geometry(nodes, elements, gw, nf, off):
     return geo, Wt
 
 
+@njit(cache=True, nogil=True, inline="always")
+def _panel_node(kid, kp, x0, x1, a, ux, uy, s0, s1, xi, w, normal, kind, p, gll_x, gll_b,
+                kv, phi):
+    """One Gauss node s = s0 + (s1 - s0) xi of a panel of the element a + s (ux, uy): the
+    kernel values at x - y(s) into ``kv``, the basis values at 2 s - 1 into ``phi``;
+    returns its weight ``w`` (the node loop of both near-pair kernels below)."""
+    s = s0 + (s1 - s0) * xi
+    rx = x0 - (a[0] + s * ux)
+    ry = x1 - (a[1] + s * uy)
+    pot_kernel(kid, rx, ry, normal[0], normal[1], kp, kv)
+    eval_basis(kind, p, 2.0 * s - 1.0, gll_x, gll_b, phi)
+    return w
+
+
 @njit(cache=True, nogil=True)
 def _potential_rows(kid, kp, d, nout, pts, rows, nodes, elements, normals, degrees, kind,
                     dofs, coef, gx, gw, gll_x, gll_b, nf, off, Y, FV, thr2, out):
@@ -324,12 +338,9 @@ def _potential_rows(kid, kp, d, nout, pts, rows, nodes, elements, normals, degre
                 h = (s1 - s0) * L
                 n = _order(2.0 * dist / h, deg, nmax)
                 for k in range(n):
-                    s = s0 + (s1 - s0) * gx[n, k]
-                    w = gw[n, k] * h
-                    rx = x0 - (a[0] + s * ux)
-                    ry = x1 - (a[1] + s * uy)
-                    pot_kernel(kid, rx, ry, normals[e, 0], normals[e, 1], kp, kv)
-                    eval_basis(kind, p, 2.0 * s - 1.0, gll_x, gll_b, phi)
+                    w = _panel_node(kid, kp, x0, x1, a, ux, uy, s0, s1, gx[n, k],
+                                    gw[n, k] * h, normals[e], kind, p, gll_x, gll_b, kv,
+                                    phi)
                     for c in range(d):
                         fv[c] = 0.0
                     for j in range(nl):
@@ -473,12 +484,9 @@ def _potential_matrix_rows(kid, kp, d, nout, pts, nodes, elements, normals, degr
                 h = (s1 - s0) * L
                 n = _order(2.0 * dist / h, deg, nmax)
                 for k in range(n):
-                    s = s0 + (s1 - s0) * gx[n, k]
-                    w = gw[n, k] * h
-                    rx = x0 - (a[0] + s * ux)
-                    ry = x1 - (a[1] + s * uy)
-                    pot_kernel(kid, rx, ry, normals[e, 0], normals[e, 1], kp, kv)
-                    eval_basis(kind, p, 2.0 * s - 1.0, gll_x, gll_b, phi)
+                    w = _panel_node(kid, kp, x0, x1, a, ux, uy, s0, s1, gx[n, k],
+                                    gw[n, k] * h, normals[e], kind, p, gll_x, gll_b, kv,
+                                    phi)
                     for j in range(nl):
                         g = dofs[e, j]
                         if g >= 0:
