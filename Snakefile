@@ -118,8 +118,9 @@ def config_flags(*exps):
 
 # One thread per job (snakemake -j2 on 2 cores never oversubscribes): numba, OpenMP and
 # BLAS pools are pinned to the job's thread count.
-THREAD_ENV = " ".join(f"{v}={{threads}}" for v in (
-    "NUMBA_NUM_THREADS", "OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"))
+THREAD_VARS = ("NUMBA_NUM_THREADS", "OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS",
+               "MKL_NUM_THREADS")
+THREAD_ENV = " ".join(f"{v}={{threads}}" for v in THREAD_VARS)
 PYTHON = shlex.quote(sys.executable)
 
 # Interrupted runs: every job watches the Snakemake process that started it (this one:
@@ -204,7 +205,61 @@ def _end_heartbeat(path):
     path.unlink(missing_ok=True)
 
 
+# Local runs: a job server (hpfebe.jobserver) imports numpy, scipy, matplotlib,
+# scikit-fem and hpfebe once and forks a process per job; `python -m hpfebe` in a job
+# hands its command to it (HPFEBE_JOBSERVER, inherited, not part of any command: the
+# same jobs rerun with or without it) and runs it itself when the server cannot take it
+# (another environment).  Each job's process start-up (interpreter and imports, about
+# 2 s) was half of a quick run.  `--config jobserver=false` turns it off.
+JOBSERVER = config.get("jobserver", True)
+if str(JOBSERVER).lower() in ("true", "false"):   # (--config gives the text)
+    JOBSERVER = str(JOBSERVER).lower() == "true"
+else:
+    raise ValueError(f"config key 'jobserver' must be true or false, got {JOBSERVER!r}")
+_JOBSERVER_PROC = []
+
+
+def _start_jobserver():
+    import subprocess
+    import tempfile
+
+    sock = Path(tempfile.gettempdir(), f"hpfebe-jobs-{os.getuid()}-{os.getpid()}.sock")
+    logfile = Path(".snakemake", "hpfebe", "jobserver.log")
+    logfile.parent.mkdir(parents=True, exist_ok=True)
+    env = {**os.environ, **{v: "1" for v in THREAD_VARS}}   # as every job's command
+    with open(logfile, "w") as log:
+        proc = subprocess.Popen([sys.executable, "-m", "hpfebe.jobserver",
+                                 "--socket", str(sock)], stdin=subprocess.PIPE,
+                                stdout=log, stderr=log, env=env)
+    _JOBSERVER_PROC.append(proc)
+    os.environ["HPFEBE_JOBSERVER"] = str(sock)
+    os.environ["HPFEBE_JOBSERVER_PID"] = str(proc.pid)
+    atexit.register(_stop_jobserver)
+
+
+def _stop_jobserver():
+    for proc in _JOBSERVER_PROC:
+        if proc.poll() is None:
+            proc.terminate()
+            try:
+                proc.wait(timeout=15)
+            except Exception:
+                proc.kill()
+    _JOBSERVER_PROC.clear()
+    os.environ.pop("HPFEBE_JOBSERVER", None)
+
+
+onsuccess:
+    _stop_jobserver()
+
+
+onerror:
+    _stop_jobserver()
+
+
 onstart:
+    if not workflow.non_local_exec and workflow.is_main_process and JOBSERVER:
+        _start_jobserver()
     if workflow.non_local_exec:      # (known here, not yet when this file is read)
         _hb = Path(".snakemake", "hpfebe", f"heartbeat.{socket.gethostname()}.{os.getpid()}")
         _hb.parent.mkdir(parents=True, exist_ok=True)
@@ -442,4 +497,4 @@ rule report:
     log:
         f"{LOGS}/report.log",
     shell:
-        f"{PYTHON} -m hpfebe report --results {RESULTS} --out report 2> {{log}}"
+        f"{THREAD_ENV} {PYTHON} -m hpfebe report --results {RESULTS} --out report 2> {{log}}"

@@ -39,7 +39,7 @@ ROOT = Path(__file__).resolve().parents[1]
 #: ``hpfebe`` (its lazy curated API reaches every layer) sits on top with the CLI
 LAYERS = (("_numba_cache", "checks"), ("geometry", "quadrature"), ("spaces",), ("constitutive",), ("solvers",), ("bem",),
           ("fem",), ("analysis",), ("bodies",), ("coupling",), ("contact",), ("adaptivity",),
-          ("io",), ("scenes",), ("suite",), ("cli", "__main__", "hpfebe"))
+          ("io",), ("scenes",), ("suite",), ("cli", "__main__", "jobclient", "jobserver", "hpfebe"))
 PKG = ROOT / "src" / "hpfebe"
 PKG_NAME = "hpfebe"
 

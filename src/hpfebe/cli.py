@@ -446,20 +446,47 @@ def cmd_report(args) -> int:
     return EXIT_OK
 
 
+def _host_key() -> dict:
+    """What numba's cached machine code depends on besides the sources (the digest
+    directory's name): the interpreter, numba and the CPU it was compiled for."""
+    import platform
+
+    import llvmlite.binding as llvm
+    import numba
+
+    return {"python": platform.python_version(), "numba": numba.__version__,
+            "cpu": llvm.get_host_cpu_name(), "features": llvm.get_host_cpu_features()
+            .flatten()}
+
+
 def cmd_compile(args) -> int:
     """Compile (or load from numba's cache) every numba kernel once; with --stamp FILE,
-    record the times in FILE (JSON, written atomically: the workflow's numba_cache rule)."""
+    record the times in FILE (JSON, written atomically: the workflow's numba_cache rule).
+    A complete warm-up leaves ``ready.json`` in the cache directory of this source tree:
+    a later call on the same host finds it and returns at once (``--force`` runs the
+    warm-up again; a kernel missing from the cache would still compile where it is
+    called, as without the warm-up)."""
     from . import _numba_cache
     from .suite.results import atomic_write
     from .suite.warmup import compile_kernels
 
+    cache = Path(os.environ[_numba_cache.ENV])
+    ready, key = cache / "ready.json", _host_key()
+    try:
+        done = not args.force and json.loads(ready.read_text()) == key
+    except (OSError, ValueError):
+        done = False
     with JitTimer() as jit:
         t0 = time.perf_counter()
-        steps = compile_kernels()
+        steps = {} if done else compile_kernels()
         wall = time.perf_counter() - t0
-    cache = Path(os.environ[_numba_cache.ENV])
-    log.info("numba kernels ready in %.1f s (compiling %.1f s; cache %s): %s", wall,
-             jit.compile_s, cache, ", ".join(f"{k} {v:.2f} s" for k, v in steps.items()))
+    if done:
+        log.info("numba kernels ready: compiled before into %s (--force: again)", cache)
+    else:
+        log.info("numba kernels ready in %.1f s (compiling %.1f s; cache %s): %s", wall,
+                 jit.compile_s, cache, ", ".join(f"{k} {v:.2f} s" for k, v in steps.items()))
+        if cache.is_dir():
+            atomic_write(ready, lambda f: json.dump(key, f))
     if cache.is_dir():
         os.utime(cache)                  # readied now: kept by remove_stale
     for old in _numba_cache.remove_stale():
@@ -514,6 +541,8 @@ def build_parser() -> argparse.ArgumentParser:
     sp = sub.add_parser("compile", help="compile the numba kernels once (a fresh machine's "
                                         "first run; later runs load them from the cache)")
     sp.add_argument("--stamp", metavar="FILE", help="write the times to FILE (JSON)")
+    sp.add_argument("--force", action="store_true",
+                    help="run the warm-up even if this tree's kernels were readied before")
     sp.set_defaults(func=cmd_compile)
     return p
 

@@ -44,6 +44,14 @@ def test_compile_writes_stamp(tmp_path):
     assert r.returncode == 0, r.stderr
     prov = json.loads((tmp_path / "res" / "figure_3_2.json").read_text())["provenance"]
     assert prov["run"]["jit_compile_s"] == 0.0
+    # the second call finds the tree's kernels readied (ready.json) and runs no warm-up
+    r = run("compile", "--stamp", str(tmp_path / "again.json"))
+    assert r.returncode == 0 and "compiled before into" in r.stderr, r.stderr
+    assert json.loads((tmp_path / "again.json").read_text())["steps_s"] == {}
+    r = run("compile", "--force", "--stamp", str(tmp_path / "forced.json"))
+    assert r.returncode == 0, r.stderr
+    forced = json.loads((tmp_path / "forced.json").read_text())
+    assert set(forced["steps_s"]) == set(rec["steps_s"]) and forced["jit_compile_s"] == 0.0
 
 
 @pytest.mark.skipif(shutil.which("hpfebe") is None, reason="console script not on PATH")

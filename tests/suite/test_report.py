@@ -396,3 +396,24 @@ def test_shown_columns_beside_the_judged_ones(tmp_path):
     build_report(res, tmp_path / "out", pub)
     md = (tmp_path / "out" / "report.md").read_text()
     assert "| ok | 175 | 13 | x0.0743 |" in md and "Not judged: newton." in md
+
+
+def test_figure_encoding_cache(tmp_path, monkeypatch):
+    """The report's re-encoded PNGs come from a cache keyed on the bytes: the same bytes
+    with or without it, one entry per distinct figure, a damaged entry encoded again."""
+    from hpfebe.suite.report import figures as rf
+
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "cache"))
+    res = tmp_path / "r"
+    for i, w in ((1, 20.0), (2, 4.0)):
+        write_result(ArtefactResult(name=f"figure_9_{i}", table=pd.DataFrame({"x": [1]}),
+                                    figure=_fig(width_in=w)), res, run_info={"module": "ch9"})
+    pngs = [res / "figure_9_1.png", res / "figure_9_2.png"]
+    fresh = [rf.encode_for_html(p.read_bytes()) for p in pngs]
+    assert [rf.png_for_html(p) for p in pngs] == fresh           # encoded, then stored
+    entries = sorted((tmp_path / "cache" / "hpfebe" / "report-png").glob("*.png"))
+    assert len(entries) == 2
+    assert [rf.png_for_html(p) for p in pngs] == fresh           # from the cache
+    entries[0].write_bytes(b"damaged")
+    assert [rf.png_for_html(p) for p in pngs] == fresh
+    assert all(e.read_bytes().startswith(rf.PNG_SIGNATURE) for e in entries)

@@ -152,6 +152,17 @@ def test_one_artefact_runs_its_job_only(built):
     assert "stops when process" in log and "the Snakemake that started it" in log
 
 
+def test_local_jobs_run_in_the_job_server(built):
+    """A local run starts the job server (Snakefile onstart): both jobs ran in processes
+    forked from it, exited 0, and the server stopped with the run."""
+    tree, _ = built
+    log = (tree / ".snakemake" / "hpfebe" / "jobserver.log").read_text()
+    for rule in ("bem_laplace", "ch2_coercivity"):
+        assert f": run {rule} --out results --quick" in log, log
+    assert log.count(": exit 0") == 2 and "refused" not in log
+    assert log.rstrip().endswith("jobserver: stopped"), log
+
+
 def test_second_call_does_nothing(built):
     tree, targets = built
     assert planned(snakemake("-n", *targets, "--configfile", "config/quick.yaml",

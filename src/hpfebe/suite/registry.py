@@ -259,14 +259,15 @@ def _sources(name: str, directory: Path) -> tuple[Path, ...]:
 
 def unknown_sections(config: dict, modules) -> list[tuple[str, str | None]]:
     """Top-level keys of a merged config that are neither a workflow key (``quick``,
-    ``bundles``: the SLURM profile's bundles file) nor a module name, each with the
-    module name it is a likely misspelling of (or None)."""
+    ``bundles``: the SLURM profile's bundles file, ``jobserver``: the local job server)
+    nor a module name, each with the module name it is a likely misspelling of (or
+    None)."""
     import difflib
 
     modules = sorted(modules)
     out = []
     for key in config:
-        if key not in ("quick", "bundles") and key not in modules:
+        if key not in ("quick", "bundles", "jobserver") and key not in modules:
             close = difflib.get_close_matches(str(key), modules, n=1, cutoff=0.8)
             out.append((str(key), close[0] if close else None))
     return out
