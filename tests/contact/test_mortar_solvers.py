@@ -205,6 +205,13 @@ def test_compiled_uzawa_step_is_the_numpy_iteration(sticky):
         n = min(len(info.residuals), len(info_ref.residuals))
         np.testing.assert_allclose(info.residuals[:n - 1], info_ref.residuals[:n - 1],
                                    rtol=1e-6)
+    # the compiled loop's cap: fixed_point's "max_iter" outcome, one increment per step
+    _, lam3, info3 = pr.uzawa(Q, UzawaSettings(rho=rho, tol=1e-12, max_iter=3,
+                                                relative=False))
+    lam3_ref, info3_ref = _numpy_uzawa(pr, Q, rho, None, 1e-12, 3)
+    assert (info3.converged, info3.reason, info3.iterations) == (False, "max_iter", 3)
+    assert info3_ref.reason == "max_iter" and len(info3.residuals) == 3
+    np.testing.assert_allclose(lam3, lam3_ref, rtol=0, atol=1e-9 * np.abs(lam3_ref).max())
     with pytest.raises(ValueError, match="lam0"):
         pr.uzawa(Q, lam0=np.zeros(nc + 1))
     with pytest.raises(ValueError, match="x0"):

@@ -56,8 +56,14 @@ def fixed_point(update: Callable[[np.ndarray], Any], x0: np.ndarray, tol: float,
             info.converged, info.reason = True, "converged"
             return x, info
         if inc > divergence * smallest:
-            info.reason = (f"diverged: increment {inc:.3e} at iteration {k} exceeds "
-                           f"{divergence:g} x the smallest ({smallest:.3e})")
+            info.reason = growth_reason(inc, k, divergence, smallest)
             return x, info
         smallest = min(smallest, inc)
     return x, info
+
+
+def growth_reason(inc: float, k: int, divergence: float, smallest: float) -> str:
+    """The reason of :func:`fixed_point`'s divergence test (also of the compiled loops
+    that follow its rules, :func:`hpfebe.solvers.uzawa.tresca_uzawa`)."""
+    return (f"diverged: increment {inc:.3e} at iteration {k} exceeds {divergence:g} x the "
+            f"smallest ({smallest:.3e})")

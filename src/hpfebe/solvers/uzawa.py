@@ -15,9 +15,10 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit
 
-from ..checks import boolean, choice, integer, real, tolerance
+from ..checks import array, boolean, choice, integer, real, tolerance
 from ..constitutive.laws import friction_projection, normal_projection, tresca_return
-from .fixed_point import fixed_point
+from .fixed_point import fixed_point, growth_reason
+from .info import SolverInfo
 from .pcg import BoundQP, _per_node, _polyak_core, pcg_info
 
 FRICTIONS = ("coulomb", "tresca")
@@ -79,6 +80,49 @@ def _uzawa_step(A, b, Fw, rhoF, Qt, upper, lam, x, tol, max_iter, res, nA, lam_n
     return status, steps, nres, active
 
 
+# outcomes of _uzawa_loop
+_CONVERGED, _MAX_ITER, _QP_FAILED, _NONFINITE, _GROWTH = range(5)
+#: fixed_point's divergence factor (its default), the same rule in the compiled loop
+DIVERGENCE = 1e6
+
+
+@njit(cache=True)
+def _uzawa_loop(A, b, Fw, rhoF, Qt, upper, lam, x, tol_cg, max_cg, res, nA, tol, max_iter,
+                incs, counts):
+    """Algorithm 4.4's iteration in one compiled call: :func:`_uzawa_step` until the
+    stopping and divergence rules of :func:`hpfebe.solvers.fixed_point` (norm 2,
+    min_iter 1, divergence :data:`DIVERGENCE`) end it, with the same floating-point
+    operations (the increment's norm sqrt(d . d), as numpy's).  ``lam`` (in: lambda_0,
+    out: the last accepted iterate), ``x`` (the QP start, out: the last QP's solution),
+    ``incs[k - 1]`` the increments, ``counts``: (QP solves, CG steps, iterations, last
+    QP's status, steps, n_residuals, active set size).  Returns an outcome code."""
+    nc = lam.size
+    lam_new = np.empty(nc)
+    smallest = np.inf
+    tiny = np.finfo(np.float64).tiny
+    for k in range(1, max_iter + 1):
+        status, steps, nres, active = _uzawa_step(A, b, Fw, rhoF, Qt, upper, lam, x,
+                                                  tol_cg, max_cg, res, nA, lam_new)
+        counts[0] += 1
+        counts[1] += steps
+        counts[2] = k
+        counts[3], counts[4], counts[5], counts[6] = status, steps, nres, active
+        if status != 1:              # a failed QP ends the iteration (lambda kept)
+            return _QP_FAILED
+        d = lam_new - lam
+        inc = np.sqrt(np.dot(d, d))
+        incs[k - 1] = inc
+        if not np.isfinite(inc) or not np.all(np.isfinite(lam_new)):
+            return _NONFINITE
+        lam[:] = lam_new
+        if inc <= tol * max(np.sqrt(np.dot(lam, lam)), tiny):
+            return _CONVERGED
+        if inc > DIVERGENCE * smallest:
+            return _GROWTH
+        smallest = min(smallest, inc)
+    return _MAX_ITER
+
+
 def tresca_uzawa(qp: BoundQP, Fw, rhoF, Qt, upper, lam0, x0=None,
                  settings: UzawaSettings = UzawaSettings()):
     """Algorithm 4.4 (Uzawa for given friction) on the contact QP ``qp`` of body 1 in the
@@ -90,8 +134,10 @@ def tresca_uzawa(qp: BoundQP, Fw, rhoF, Qt, upper, lam0, x0=None,
     lambda_{m-1}|| <= tol ||lambda_m|| (:func:`fixed_point`; ``settings``: tol, max_iter,
     cg_tol, its rho already in ``rhoF``).  ``Fw``: the friction
     weights F w_j (or s_j w_j for a nodal bound s), ``rhoF``: rho F (or rho s_j),
-    ``Qt``: the tangential obstacle, ``upper``: (g + Q_n, +inf), all per node.  Each
-    iteration is one compiled call (:func:`_uzawa_step`: the QP and the projection).
+    ``Qt``: the tangential obstacle, ``upper``: (g + Q_n, +inf), all per node.  The whole
+    iteration is one compiled call (:func:`_uzawa_loop`: the QP and the projection per
+    step, :func:`fixed_point`'s rules; Python's 60 us per step of the loop around one
+    compiled step were two thirds of Table 4.1's 366k steps).
     Returns (x, lambda, info); x solves the QP of the returned lambda.  ``info.counts``:
     the QP solves and their CG steps in all; ``info.steps`` holds a QP's SolverInfo only
     where it failed (that ends the iteration) - one SolverInfo per iteration kept for
@@ -104,26 +150,28 @@ def tresca_uzawa(qp: BoundQP, Fw, rhoF, Qt, upper, lam0, x0=None,
         raise ValueError(f"x0 must have shape ({n},), got {np.shape(x0)}")
     args = (A, b, _per_node(Fw, nc), _per_node(rhoF, nc), _per_node(Qt, nc),
             _per_node(upper, n))
-    tol_cg = float(settings.cg_tol)
-    state = {"x": x0}
-    cg = [0, 0]                                      # QP solves, CG steps
-
-    def update(lam):
-        x = np.zeros(n) if state["x"] is None else np.array(state["x"], dtype=float)
-        lam_new = np.empty(nc)
-        status, steps, nres, active = _uzawa_step(
-            *args, np.ascontiguousarray(lam, dtype=float), x, tol_cg, max_cg, res, nA,
-            lam_new)
-        state["x"] = x
-        cg[0] += 1
-        cg[1] += steps
-        if status != 1:                  # a failed QP ends the iteration with its info
-            return lam_new, pcg_info(status, steps, nres, res, active)
-        return lam_new
-
-    lam, info = fixed_point(update, lam0, settings.tol, settings.max_iter, norm=2)
-    info.counts = dict(qp_solves=cg[0], cg_steps=cg[1])
-    x, qinfo = qp.solve(friction_rhs(b, Fw, lam), upper, state["x"], settings.cg_tol)
+    tol = real("tol", settings.tol, positive=True)
+    max_iter = integer("max_iter", settings.max_iter, lo=1)
+    lam = np.array(array("lam0", lam0), dtype=float)
+    x = np.zeros(n) if x0 is None else np.array(x0, dtype=float)
+    incs, counts = np.empty(max_iter), np.zeros(7, np.int64)
+    outcome = _uzawa_loop(*args, lam, x, float(settings.cg_tol), max_cg, res, nA, tol,
+                          max_iter, incs, counts)
+    k = int(counts[2])
+    n_inc = k - (outcome == _QP_FAILED)
+    info = SolverInfo(outcome == _CONVERGED, "max_iter", k, incs[:n_inc].tolist(),
+                      counts=dict(qp_solves=int(counts[0]), cg_steps=int(counts[1])))
+    if outcome == _CONVERGED:
+        info.reason = "converged"
+    elif outcome == _QP_FAILED:
+        inner = pcg_info(int(counts[3]), int(counts[4]), int(counts[5]), res, int(counts[6]))
+        info.steps.append(inner)
+        info.reason = f"inner solve {k}: {inner.reason}"
+    elif outcome == _NONFINITE:
+        info.reason = f"diverged: non-finite iterate at iteration {k}"
+    elif outcome == _GROWTH:
+        info.reason = growth_reason(incs[k - 1], k, DIVERGENCE, float(np.min(incs[:k - 1])))
+    x, qinfo = qp.solve(friction_rhs(b, Fw, lam), upper, x, settings.cg_tol)
     if not qinfo.converged and info.converged:
         info.converged, info.reason = False, f"final QP: {qinfo.reason}"
     return x, lam, info
