@@ -40,13 +40,23 @@ def _times_blocks_kernel(A, D):
 
 
 @numba.njit(cache=True, inline="always")
-def _row_times_block(M, r, c, D, col):
-    """(M[r, 3c:3c+3] D[c])[col]: the 3-term sum of :func:`_times_blocks_kernel`, in its
-    order."""
-    acc = 0.0
-    for k in range(3):
-        acc += M[r, 3 * c + k] * D[c, k, col]
-    return acc
+def _row_times_blocks(row, pl, Dp, out, diag, sign):
+    """out[3 j + col] = sign (row[3 pl_j:3 pl_j + 3] Dp[j])[col] for every plastic cell j,
+    each the 3-term sum of :func:`_times_blocks_kernel` in its order (the three row
+    entries loaded once for the three columns, no branch in the loop: it vectorises);
+    ``diag`` >= 0: then out[diag] += 1 (J = I - ...: 1 - sum, the elementwise form's
+    number; -sum elsewhere, 0 - sum up to the sign of a zero)."""
+    for j in range(pl.size):
+        c = 3 * pl[j]
+        m0, m1, m2 = row[c], row[c + 1], row[c + 2]
+        for col in range(3):
+            acc = 0.0
+            acc += m0 * Dp[j, 0, col]
+            acc += m1 * Dp[j, 1, col]
+            acc += m2 * Dp[j, 2, col]
+            out[3 * j + col] = sign * acc
+    if diag >= 0:
+        out[diag] += 1.0                # 1 + (-acc) is 1 - acc exactly
 
 
 @numba.njit(cache=True)
@@ -58,20 +68,16 @@ def _plastic_blocks_kernel(M, pl, D, rows):
     elsewhere - the numbers of ``MD = _times_blocks(M[:, p], D[pl])``,
     ``np.eye(n) - MD[p]`` bit for bit."""
     n = pl.size
+    Dp = np.empty((n, 3, 3))            # the plastic blocks contiguous, read n^2 times
+    for j in range(n):
+        Dp[j] = D[pl[j]]
     MD = np.empty((rows.size, 3 * n))
     for t in range(rows.size):
-        r = rows[t]
-        for j in range(n):
-            for col in range(3):
-                MD[t, 3 * j + col] = _row_times_block(M, r, pl[j], D, col)
+        _row_times_blocks(M[rows[t]], pl, Dp, MD[t], -1, 1.0)
     J = np.empty((3 * n, 3 * n))
     for a in range(n):
         for i in range(3):
-            r = 3 * pl[a] + i
-            for j in range(n):
-                for col in range(3):
-                    J[3 * a + i, 3 * j + col] = ((1.0 if a == j and i == col else 0.0)
-                                                 - _row_times_block(M, r, pl[j], D, col))
+            _row_times_blocks(M[3 * pl[a] + i], pl, Dp, J[3 * a + i], 3 * a + i, -1.0)
     return MD, J
 
 
