@@ -41,16 +41,19 @@ class RefinedLU:
         self.singular = info > 0
         self._dlu = None
 
-    def _solve32(self, r: np.ndarray) -> np.ndarray:
+    def _solve32(self, r: np.ndarray, s: float | None = None) -> np.ndarray:
         """F^-1 r in single precision, r scaled to unit size first (a residual of
-        1e-35 would be subnormal in float32)."""
-        s = float(np.abs(r).max(initial=0.0))
+        1e-35 would be subnormal in float32); ``s``: max|r| if known."""
+        s = float(np.abs(r).max(initial=0.0)) if s is None else s
         if s == 0.0 or not math.isfinite(s):
             return np.zeros_like(r) if s == 0.0 else np.full_like(r, np.nan)
-        x, info = lapack.sgetrs(self.lu, self.piv, (r / s).astype(np.float32))
+        x, info = lapack.sgetrs(self.lu, self.piv, (r * (1.0 / s)).astype(np.float32),
+                                overwrite_b=True)
         if info != 0:
             raise ValueError(f"illegal value in argument {-info} of sgetrs")
-        return s * x.astype(float)
+        x = x.astype(float)
+        x *= s
+        return x
 
     def solve(self, b: np.ndarray, J: np.ndarray | None = None, max_refine: int = 30,
               min_rate: float = 0.5):
@@ -68,17 +71,18 @@ class RefinedLU:
         x = self._solve32(b)
         last = math.inf
         for _ in range(max_refine + 1):
-            r = b - J @ x
+            r = J @ x
+            np.subtract(b, r, out=r)
             rn = np.abs(r).max(axis=0)
-            if not np.all(np.isfinite(rn)):
+            worst = float(rn.max())
+            if not math.isfinite(worst):
                 return None
             if np.all(rn <= bound * np.abs(x).max(axis=0)):
                 return x
-            worst = float(rn.max())
             if worst > min_rate * last:
                 return None
             last = worst
-            x += self._solve32(r)
+            x += self._solve32(r, worst if r.ndim == 1 else None)
         return None
 
     def solve_or_exact(self, b: np.ndarray) -> np.ndarray:
