@@ -230,9 +230,9 @@ class ElastoPlasticBE(CellStrainOperators):
         :data:`RECENT_SOLVES` solutions at the committed state are kept (a point met
         again returns its solution and restores the prediction base of that time).
         Measured,
-        the four BE/BE runs of Example 2 (CPU, A/B against the double LU at every step
-        and solution and the numpy return map): 13.1 -> 10.6 s, records within 6e-14
-        relative, iterations identical."""
+        the four BE/BE runs of Example 2 (CPU, interleaved A/B against the double LU at
+        every step and solution and the numpy return map, load ~14 on 2 cores):
+        12.0 -> 8.2 s, records within 7e-14 relative, iterations identical."""
         u = np.asarray(u, dtype=float)
         key = u.tobytes()
         for k, out, committed, ilast, info in getattr(self, "_icache", None) or ():
@@ -360,8 +360,9 @@ def _solve_plastic(body: "ElastoPlasticBE", pl: np.ndarray, J: np.ndarray,
     precision cannot factorise goes to a double LU (singular: :class:`SingularStep`;
     ``exact``: the LU of scipy.linalg.lu_factor, no check, as at the inner solution).
     Measured (the four BE/BE runs of Example 2): 1546 double LU solves and 416 double
-    LU factors at the inner solutions -> 1112 single-precision factors and about 830
-    refined reuses (4-5 refinement steps a solve), records within 6e-14 relative."""
+    LU factors at the inner solutions -> 1047 single-precision factors, about 800
+    refined reuses and 199 double solves for tangents (4-5 refinement steps a solve),
+    records within 7e-14 relative."""
     f = getattr(body, "_factor", None)
     if f is not None and np.array_equal(f.pl, pl):
         x = f.solve(rhs, J, max_refine=8, min_rate=0.25)
