@@ -488,3 +488,28 @@ def test_potential_matrix_is_the_columns_of_evaluate_potential():
     assert np.array_equal(A, cols)
     with pytest.raises(PointOnBoundaryError, match="points must lie off"):
         potential_matrix(POT_LAME_DL, bem.kp, 2, [[0.0, 0.0], [0.2, 0.5]], bem.V_space)
+
+
+def test_recent_inner_solutions_are_reused_at_their_committed_state(punch_bodies):
+    """A point met again among the last RECENT_SOLVES inner solves returns its solution
+    (the same objects, its inner diagnostics) without a new solve; after a commit the
+    kept solutions of the old history are never returned."""
+    from hpfebe.bodies import plastic_be
+    _, be0 = punch_bodies
+    be = ElastoPlasticBE(be0.bem, be0.cells, MAT, scheme="implicit")
+    u = _plastic_punch(be)
+    first = be.implicit_response_lazy(u)
+    info = be.inner_info
+    assert info.iterations > 0 and first[1].plastic.sum() > 3
+    for s in (0.9, 0.95):
+        be.implicit_response_lazy(s * u)
+    assert be.inner_info is not info
+    again = be.implicit_response_lazy(u)
+    assert again is first and be.inner_info is info
+    for s in np.linspace(0.5, 0.8, plastic_be.RECENT_SOLVES):
+        be.implicit_response_lazy(s * u)
+    assert be.implicit_response_lazy(u) is not first        # dropped: recomputed
+    be.commit(0.5 * u)
+    after = be.implicit_response_lazy(u)
+    assert after is not first
+    assert not np.array_equal(after[0], first[0])           # another history
