@@ -296,3 +296,23 @@ def test_scene_parameters_and_exports():
     out = section44_fields.mortar_exports(sc, sol)
     assert sorted(out) == ["contact", "stamp", "work"]
     assert out["stamp"].points.shape[0] == 5 * 9
+
+
+def test_penalty_scene_copies_and_monolithic_memo():
+    """penalty_scene hands out independent copies of one pristine pair (a run's state
+    and committed history stay in its copy: a second run equals the first), and the
+    monolithic solution of a mortar problem is solved once per settings."""
+    from hpfebe.scenes import section44_runs
+    from hpfebe.scenes.section44 import Section44Scene, penalty_scene
+
+    prm = Section44Scene(work_cells=(16, 8), stamp_cells=(4, 8), h_stamp=0.5, n_load=2)
+    a, b = (section44_runs.run_penalty(prm, 10.0) for _ in range(2))
+    assert a.result.converged and b.result.converged
+    assert a.fe is not b.fe and np.abs(a.fe.committed.eps_p).max() > 0
+    assert np.array_equal(a.peak.u_work, b.peak.u_work)
+    assert [r.iterations for r in a.result.records] == [r.iterations for r in b.result.records]
+    stamp, fe = penalty_scene(prm.penalty_cells, prm.h_stamp, prm.material())
+    assert np.abs(fe.committed.eps_p).max() == 0 and fe is not a.fe
+    sc = section44_runs.mortar_scene(prm)
+    assert sc.monolithic() is sc.monolithic()
+    assert sc.monolithic(tol=1e-9) is not sc.monolithic()

@@ -29,6 +29,8 @@ lifted by 1e-4; E = 266926, nu = 0.29, sigma_Y = 4.0, H = 450.0
 
 from __future__ import annotations
 
+import copy
+import functools
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -87,8 +89,24 @@ def penalty_scene(work_cells, h_stamp: float, material: J2Material,
     """The penalty scene of Section 4.4 (FE/BE): the Galerkin BE stamp on :data:`STAMP`
     (P1 for ``be_degree`` 1, mesh size ``h_stamp``) and the Q1 work piece on
     :data:`WORK` (``work_cells`` = (nx, ny), ``formulation`` "full" or "bbar").
-    Returns (stamp, work piece) for :func:`hpfebe.scenes.stamping.touch`."""
+    Returns (stamp, work piece) for :func:`hpfebe.scenes.stamping.touch`: fresh copies
+    of one pair built per arguments (:func:`_penalty_template`), since a touch changes
+    the work piece's state."""
+    cells = tuple(int(c) for c in array("work_cells", work_cells, shape=(2,), dtype=int))
+    return copy.deepcopy(_penalty_template(cells, real("h_stamp", h_stamp, positive=True),
+                                           material, formulation, int(be_degree)))
+
+
+@functools.lru_cache(maxsize=8)
+def _penalty_template(work_cells: tuple, h_stamp: float, material: J2Material,
+                      formulation: str, be_degree: int):
+    """The pristine (stamp, work piece) of :func:`penalty_scene`, the work piece's
+    element lookup at :data:`X_POINT` (the touch's records) done: Table 4.3, the figures
+    and their variants run up to 19 touches on a few meshes, and a copy costs a fifth of
+    the assembly (the B operators, the elastic tangent's pattern) and lookup (measured
+    0.014 s against 0.09 s on 61 x 31 cells)."""
     fe = ElastoPlasticFE(rectangle_mesh(*WORK, *work_cells), material, formulation)
+    fe.elements_at(X_POINT)
     stamp = stamp_body("BE", STAMP, h_stamp, material.E, material.nu, p=be_degree)
     return stamp, fe
 
@@ -213,12 +231,17 @@ class Section44Scene:
     def settings(self, factor: float) -> StampContact:
         """Penalty 1/eps_n = factor E, 1/eps_t = eps_t_ratio factor E; Coulomb mu_f or
         (penalty_law 'tresca') the mortar's Tresca bound F; Newton (rtol, max_newton,
-        max_cuts, line search, bonded predictor)."""
+        max_cuts, line search, bonded predictor), its systems by SuperLU with the
+        minimum degree ordering of A + A^T and diagonal pivots ("MMD_AT_PLUS_A"):
+        1.3x (61 x 31 cells) to 1.7x (88 x 44) faster per run than COLAMD, measured on
+        every run of the section (sweeps, variants): the same Newton iterations in every
+        increment, the fields within 4e-14 (relative)."""
         return StampContact(factor, self.eps_t_ratio * factor, self.mu_f,
                             F=self.F if self.penalty_law == "tresca" else None,
                             two_pass=self.two_pass, solver=ContactSettings(
                                 rtol=self.rtol, max_iter=self.max_newton,
-                                max_cuts=self.max_cuts, line_search=True, predictor=True))
+                                max_cuts=self.max_cuts, line_search=True, predictor=True,
+                                lu_ordering="MMD_AT_PLUS_A"))
 
     @property
     def penalty_cells(self) -> tuple[int, int]:
