@@ -273,6 +273,48 @@ def test_fe_indicator_vanishes_for_linear_solution():
         fe_indicators(b, U, tractions={"Q": g})
 
 
+@pytest.mark.parametrize("vector", [False, True])
+def test_fe_indicator_cellwise_equals_quadrature(vector):
+    """The closed-form P1 path equals scikit-fem's facet quadrature to round-off on a
+    distorted, adaptively refined mesh with a random field and a non-polynomial datum on
+    a boundary part (scalar: Poisson; vector: Hooke's law)."""
+    from hpfebe.adaptivity import lame_stress
+    rng = np.random.default_rng(3)
+    m = skfem.MeshTri.init_sqsymmetric().refined(2)
+    m = m.refined(np.arange(0, m.t.shape[1], 5))
+    m = skfem.MeshTri(m.p + 0.02 * rng.standard_normal(m.p.shape)
+                      * (np.abs(m.p - 0.5) < 0.49).all(axis=0), m.t)
+    m = m.with_boundaries({"N": lambda x: np.abs(x[1]) < 1e-12,
+                           "F": lambda x: np.abs(x[0] - 1) < 1e-12})
+    elem = skfem.ElementVector(ElementTriP1()) if vector else ElementTriP1()
+    b = Basis(m, elem)
+    U = rng.standard_normal(b.N)
+    if vector:
+        stress = lame_stress(266926.0, 0.29)
+        g = lambda x, y, nx, ny: np.array([np.sin(7 * x) + ny, x * x * nx])  # noqa: E731
+        zero = lambda x, y, nx, ny: np.zeros((2,) + np.shape(x))              # noqa: E731
+    else:
+        stress = None
+        g = lambda x, y, nx, ny: np.sin(7 * x) + np.abs(x - 0.3) * ny         # noqa: E731
+        zero = lambda x, y, nx, ny: 0 * x                                     # noqa: E731
+    kw = dict(stress=stress, tractions={"N": g, "F": zero}, return_parts=True)
+    eta_c, parts_c = fe_indicators(b, U, method="cellwise", **kw)
+    eta_q, parts_q = fe_indicators(b, U, method="quadrature", **kw)
+    assert parts_q["jump"].min() > 0 and parts_q["boundary"].max() > 0
+    for k in ("jump", "boundary"):
+        np.testing.assert_allclose(parts_c[k], parts_q[k], rtol=1e-12,
+                                   atol=1e-14 * parts_q[k].max())
+    np.testing.assert_allclose(eta_c, eta_q, rtol=1e-12)
+    assert np.array_equal(fe_indicators(b, U, stress=stress, tractions={"N": g}),
+                          fe_indicators(b, U, stress=stress, tractions={"N": g},
+                                        method="cellwise"))
+    with pytest.raises(ValueError, match="method"):
+        fe_indicators(b, U, method="exact")
+    q = Basis(skfem.MeshQuad().refined(1), skfem.ElementQuad1())
+    with pytest.raises(ValueError, match="cellwise"):
+        fe_indicators(q, np.zeros(q.N), method="cellwise")
+
+
 # ----------------------------------------------------------------------------- loop
 def test_adapt_validation_and_tol_stop():
     solve = lambda m: (None, m.n_elements)                        # noqa: E731

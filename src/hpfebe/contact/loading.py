@@ -405,6 +405,10 @@ class WoodburySolver:
                              "linear_solver='lu'")
         self.row_pos = np.full(self.n, -1, dtype=np.int64)
         self.row_pos[self.rows] = np.arange(self.rows.size)
+        # [Gn; Gt] on the contact dofs (columns: positions in rows): B of a step is a
+        # row selection, B (K^-1)_cc B^T costs nnz(B) (contact dofs + 2 m) flops
+        self.npts = self.Gn.shape[0]
+        self.G_c = sp.vstack([self.Gn, self.Gt]).tocsc()[:, self.rows].tocsr()
         self.from_factors = []       # per body: (K^-1)_cc from the factors (else solves)
         # the body blocks of K on the free dofs (no coupling between the bodies in K)
         split = int(np.searchsorted(free, offset))
@@ -487,21 +491,23 @@ class WoodburySolver:
         if act.size == 0:
             return y
         m = act.size
-        B = sp.vstack([self.Gn[act], self.Gt[act]]).tocsc()
-        dofs = np.flatnonzero(np.diff(B.indptr))
-        Bd = B[:, dofs].toarray()
-        H = Bd @ self._columns(dofs) @ Bd.T
-        M = np.zeros((2 * m, 2 * m))
-        i = np.arange(m)
-        M[i, i] = wn[act]
-        M[m + i, i] = -wtn[act]
-        M[m + i, m + i] = wt[act]
+        # B = [Gn; Gt] on the active points, on the contact dofs (sparse)
+        B = self.G_c[np.concatenate([act, act + self.npts])]
+        H = B @ (B @ self.kinv_cc.T).T          # B (K^-1)_cc B^T
+        # M H and M B y with M = [[W_n, 0], [-W_tn, W_t]] (diagonal blocks): row scalings
+        an, at, atn = wn[act], wt[act], wtn[act]
+        MH = np.concatenate([an[:, None] * H[:m], -atn[:, None] * H[:m] + at[:, None] * H[m:]])
+        By = B @ y[self.rows]
+        MBy = np.concatenate([an * By[:m], -atn * By[:m] + at * By[m:]])
+        MH[np.arange(2 * m), np.arange(2 * m)] += 1.0
         try:
-            s = sla.solve(np.eye(2 * m) + M @ H, M @ (B @ y))
+            s = sla.solve(MH, MBy)
         except (np.linalg.LinAlgError, ValueError):
             raise SingularStep("singular Newton matrix (contact update of the "
                                "Woodbury formula)") from None
-        return y - self._kinv(B.T @ s)
+        Bs = np.zeros(self.n)
+        Bs[self.rows] = B.T @ s
+        return y - self._kinv(Bs)
 
     def matvec(self, wn, wt, wtn, d: np.ndarray) -> np.ndarray:
         """(K + C) d on the free dofs (the residual check of a solve)."""

@@ -19,6 +19,7 @@ from __future__ import annotations
 from typing import Optional, Sequence
 
 import numpy as np
+import scipy.sparse as sp
 from skfem import (
     Basis,
     ElementQuad1,
@@ -66,6 +67,33 @@ def rectangle_mesh(
     )
 
 
+def p1_stiffness(mesh, basis, lam: float, mu: float) -> sp.csr_matrix:
+    """The stiffness matrix of linear elasticity for P1 triangles in closed form (the
+    strains are constant per cell): K_e[(i, a), (j, b)] = |K| (mu d_ab grad l_i . grad l_j
+    + mu d_a l_j d_b l_i + lambda d_a l_i d_b l_j), l_i the barycentric coordinates,
+    local dof 2 i + a as scikit-fem's ElementVector(ElementTriP1); the matrix of
+    scikit-fem's quadrature assembly to round-off, about 10x faster (tests/fem)."""
+    P = mesh.p[:, mesh.t]                                   # (2, 3, nc)
+    e1, e2 = P[:, 1] - P[:, 0], P[:, 2] - P[:, 0]
+    det = e1[0] * e2[1] - e1[1] * e2[0]
+    # grad l_1 = (e2_y, -e2_x) / det, grad l_2 = (-e1_y, e1_x) / det, l_0 = 1 - l_1 - l_2
+    g1 = np.array([e2[1], -e2[0]]) / det
+    g2 = np.array([-e1[1], e1[0]]) / det
+    G = np.stack([-g1 - g2, g1, g2], axis=1)                # (2 comps, 3 nodes, nc)
+    area = 0.5 * np.abs(det)
+    dots = np.einsum("aic,ajc->ijc", G, G)                  # grad l_i . grad l_j
+    eye = np.eye(2)
+    Ke = (mu * eye[None, :, None, :, None] * dots[:, None, :, None, :]
+          + mu * np.einsum("ajc,bic->iajbc", G, G)
+          + lam * np.einsum("aic,bjc->iajbc", G, G)) * area   # (3, 2, 3, 2, nc)
+    Ke = Ke.reshape(6, 6, -1)
+    dofs = basis.element_dofs                               # (6, nc)
+    rows = np.broadcast_to(dofs[:, None, :], Ke.shape)
+    cols = np.broadcast_to(dofs[None, :, :], Ke.shape)
+    return sp.coo_matrix((Ke.ravel(), (rows.ravel(), cols.ravel())),
+                         shape=(basis.N, basis.N)).tocsr()
+
+
 class ElasticBody:
     """A linearly elastic FE body: mesh, vector P1/Q1 basis, stiffness matrix ``K``.
 
@@ -74,7 +102,11 @@ class ElasticBody:
     ratio), ``plane`` ("strain" or "stress").
     """
 
-    def __init__(self, mesh, E: float, nu: float, plane: str = "strain"):
+    def __init__(self, mesh, E: float, nu: float, plane: str = "strain",
+                 assembly: str = "quadrature"):
+        if assembly not in ("quadrature", "closed_form"):
+            raise ValueError("assembly must be 'quadrature' or 'closed_form', got "
+                             f"{assembly!r}")
         if isinstance(mesh, FEDomain):
             mesh = mesh.mesh
         if isinstance(mesh, MeshQuad):
@@ -87,7 +119,10 @@ class ElasticBody:
         self.E, self.nu, self.plane = float(E), float(nu), plane
         self.lam, self.mu = lame_constants(E, nu, plane)
         self.basis = Basis(mesh, ElementVector(elem))
-        self.K = asm(linear_elasticity(self.lam, self.mu), self.basis).tocsr()
+        if assembly == "closed_form" and isinstance(mesh, MeshTri):
+            self.K = p1_stiffness(mesh, self.basis, self.lam, self.mu)
+        else:
+            self.K = asm(linear_elasticity(self.lam, self.mu), self.basis).tocsr()
 
     # ------------------------------------------------------------------ geometry / dofs
     @property

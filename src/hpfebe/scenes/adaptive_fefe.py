@@ -144,7 +144,9 @@ class FEFEContactScene(FrictionalContactScene):
         ``load_steps`` equal increments: (problem, result)."""
         n = integer("load_steps", load_steps, lo=1)
         instance("settings", settings, ContactSettings)
-        S, M = (ElasticBody(m, self.E, self.nu, self.plane) for m in meshes)
+        # P1 stiffness in closed form (scikit-fem's quadrature matrix to round-off)
+        S, M = (ElasticBody(m, self.E, self.nu, self.plane, assembly="closed_form")
+                for m in meshes)
         pr = TwoBodyContact(S, M, CONTACT_BOUNDARY["slave"], CONTACT_BOUNDARY["master"],
                             eps_n=1.0 / (self.eps_n_factor * self.E),
                             eps_t=1.0 / (self.eps_t_factor * self.E), mu_f=self.mu_f)
