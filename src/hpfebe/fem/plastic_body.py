@@ -94,32 +94,35 @@ def _force_kernel(B, s, dx):
 
 
 @numba.njit(cache=True)
-def _state_kernel(B, ue, dx, ep, alpha, beta, mu, kappa, H, theta, sigma_Y):
+def _state_kernel(Bc, comps, ue, dx, ep, alpha, beta, mu, kappa, H, theta, sigma_Y):
     """Strain eps = B ue, the radial return from the committed (ep, alpha, beta) (all
     (nel * nq, ...)), the stress and the element forces fe[e, i] = sum_q sum_a
-    B[e, q, i, a] sigma[e, q, a] dx[e, q] in one pass over the elements."""
-    ne, nq, nl, na = B.shape
+    B[e, q, i, a] sigma[e, q, a] dx[e, q] in one pass over the elements.  ``Bc`` holds
+    the components ``comps`` of B (the others vanish: :attr:`ElastoPlasticFE._comps`),
+    so the sums skip exact zeros only: the numbers of the full 9-component sums."""
+    ne, nq, nl, nc = Bc.shape
     n = ne * nq
     sigma, ep_new, beta_new = np.empty((n, 9)), np.empty((n, 9)), np.empty((n, 9))
     normal = np.empty((n, 9))
     alpha_new, dgamma, f_trial, safe = np.empty(n), np.empty(n), np.empty(n), np.empty(n)
     fe = np.zeros((ne, nl))
-    eps = np.empty(9)
+    eps = np.zeros(9)
     for e in range(ne):
         for q in range(nq):
             p = e * nq + q
-            for a in range(na):
+            for c in range(nc):
                 acc = 0.0
                 for i in range(nl):
-                    acc += B[e, q, i, a] * ue[e, i]
-                eps[a] = acc
+                    acc += Bc[e, q, i, c] * ue[e, i]
+                eps[comps[c]] = acc
             alpha_new[p], dgamma[p], f_trial[p], safe[p] = radial_return_point(
                 eps, ep[p], alpha[p], beta[p], mu, kappa, H, theta, sigma_Y,
                 sigma[p], ep_new[p], beta_new[p], normal[p])
+            w = dx[e, q]
             for i in range(nl):
                 acc = 0.0
-                for a in range(na):
-                    acc += B[e, q, i, a] * sigma[p, a] * dx[e, q]
+                for c in range(nc):
+                    acc += Bc[e, q, i, c] * sigma[p, comps[c]] * w
                 fe[e, i] += acc
     return sigma, ep_new, alpha_new, beta_new, normal, dgamma, f_trial, safe, fe
 
@@ -139,12 +142,13 @@ def _elastic_kernel(TR, G, dx, kappa, mu):
 
 
 @numba.njit(cache=True)
-def _tangent_kernel(B, TR, G, dx, Ke_el, pos, nnz, normal, dgamma, safe, plastic,
+def _tangent_kernel(Bc, comps, TR, G, dx, Ke_el, pos, nnz, normal, dgamma, safe, plastic,
                     kappa, mu, H, algorithmic):
     """The CSR data (nnz,) of the tangent on the pattern of K (``pos[e, i, j]``: the
     position of element entry (i, j) in it): the element matrix (module doc) of every
-    element with a plastic point, the elastic one ``Ke_el`` elsewhere."""
-    ne, nq, nl, na = B.shape
+    element with a plastic point, the elastic one ``Ke_el`` elsewhere (``Bc``, ``comps``:
+    the nonzero components of B, as in :func:`_state_kernel`)."""
+    ne, nq, nl, nc = Bc.shape
     data = np.zeros(nnz)
     Ke = np.empty((nl, nl))
     m = np.empty(nl)
@@ -163,8 +167,8 @@ def _tangent_kernel(B, TR, G, dx, Ke_el, pos, nnz, normal, dgamma, safe, plastic
             t1, tb = tangent_factors(dgamma[p], safe[p], plastic[p], mu, H, algorithmic)
             for i in range(nl):
                 acc = 0.0
-                for a in range(na):
-                    acc += normal[p, a] * B[e, q, i, a]
+                for c in range(nc):
+                    acc += normal[p, comps[c]] * Bc[e, q, i, c]
                 m[i] = acc
             for i in range(nl):
                 for j in range(nl):
@@ -202,6 +206,11 @@ class ElastoPlasticFE:
         self.dx = self.basis.dx                                   # (nel, nq)
         self.nel, self.nq = self.dx.shape
         self.B = np.ascontiguousarray(self._strain_operator())    # (nel, nq, nloc, 9)
+        # the components of the strain that B can make nonzero (plane strain: xx, xy,
+        # yx, yy and, with B-bar, zz): the kernels sum over these only (the other
+        # terms are exact zeros), on a compact copy of B (5/9 of the memory traffic)
+        self._comps = np.flatnonzero(np.any(self.B != 0.0, axis=(0, 1, 2))).astype(np.int64)
+        self._Bc = np.ascontiguousarray(self.B[..., self._comps])
         self._dx_c = np.ascontiguousarray(self.dx, dtype=float)
         dofs = self.basis.element_dofs                            # (nloc, nel)
         self.element_dofs = dofs
@@ -297,8 +306,8 @@ class ElastoPlasticFE:
         if not rm.plastic.any():
             return self.K
         m = self.material
-        data = _tangent_kernel(self.B, self._TR, self._G, self._dx_c, self._Ke_el,
-                               self._pos, self.K.nnz,
+        data = _tangent_kernel(self._Bc, self._comps, self._TR, self._G, self._dx_c,
+                               self._Ke_el, self._pos, self.K.nnz,
                                np.ascontiguousarray(rm.normal.reshape(-1, 9)), rm.dgamma,
                                rm.eta_norm, rm.plastic, m.kappa, m.mu, m.H,
                                tg == "algorithmic")
@@ -330,7 +339,8 @@ class ElastoPlasticFE:
         m, c, n = self.material, self.committed, self.n_points
         ue = np.ascontiguousarray(u[self.element_dofs].T)
         sigma, ep, alpha, beta, normal, dgamma, f_trial, safe, fe = _state_kernel(
-            self.B, ue, self._dx_c, np.ascontiguousarray(c.eps_p.reshape(n, 9)),
+            self._Bc, self._comps, ue, self._dx_c,
+            np.ascontiguousarray(c.eps_p.reshape(n, 9)),
             np.ascontiguousarray(c.alpha), np.ascontiguousarray(c.beta.reshape(n, 9)),
             m.mu, m.kappa, m.H, m.theta, m.sigma_Y)
         t = (n, 3, 3)
