@@ -119,6 +119,10 @@ class NewtonMatrix:
         lr, lc = self.local[r], self.local[K.indices]
         sel = np.flatnonzero((lr >= 0) & (lc >= 0))
         pos = _lookup(self.P, lr[sel], lc[sel])
+        # a canonical K (no duplicate entries) meets every position of P once: then
+        # its entries are stored, not summed (bincount's 0 + x is x: the same numbers)
+        if np.unique(pos).size == pos.size:
+            pos = (pos,)
         self._kmap = (K.indptr.copy(), K.indices.copy(), sel, pos)
         return sel, pos
 
@@ -130,7 +134,11 @@ class NewtonMatrix:
             else sp.csr_matrix(K_body)
         sel, pos = self._body_map(K)
         m = self.P.nnz + 1                      # the last slot takes fixed dofs' entries
-        data = np.bincount(pos, K.data[sel], minlength=m)
+        if isinstance(pos, tuple):              # every position once (:meth:`_body_map`)
+            data = np.zeros(m)
+            data[pos[0]] = K.data[sel]
+        else:
+            data = np.bincount(pos, K.data[sel], minlength=m)
         vn, vt = self._vn, self._vt
         for p, a, b, w in ((self._pos_nn, vn, vn, wn), (self._pos_tt, vt, vt, wt),
                            (self._pos_tn, vt, vn, -wtn)):
