@@ -121,7 +121,8 @@ class NewtonMatrix:
         pos = _lookup(self.P, lr[sel], lc[sel])
         # a canonical K (no duplicate entries) meets every position of P once: then
         # its entries are stored, not summed (bincount's 0 + x is x: the same numbers)
-        if np.unique(pos).size == pos.size:
+        ordered = np.sort(pos)
+        if np.all(ordered[1:] != ordered[:-1]):
             pos = (pos,)
         self._kmap = (K.indptr.copy(), K.indices.copy(), sel, pos)
         return sel, pos
