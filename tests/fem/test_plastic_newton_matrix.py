@@ -128,3 +128,39 @@ def test_block_diagonal_of_plastic_tangents_reuses_its_pattern():
                         format="csr")
     assert np.abs(K2 - K1).max() > 0                               # other values
     assert np.abs((K2 - ref).toarray()).max() == 0
+
+
+def test_secant_tangent_maps_the_strain_to_the_stress_from_a_virgin_state():
+    """From a virgin history sigma = kappa tr eps 1 + 2 mu theta_1 dev eps at every
+    point, so f_int(u) = K_sec(u) u; the algorithmic tangent is softer (it does not)."""
+    fe = ElastoPlasticFE(rectangle_mesh(-1, 1, -1, 0, 6, 3), J2Material(E, NU, 4.0, 450.0))
+    rng = np.random.default_rng(1)
+    u = 1e-4 * rng.standard_normal(fe.ndofs)
+    f, rm = fe.state_at(u)
+    assert rm.plastic.mean() > 0.5
+    K_sec, K_alg = fe.tangent_matrix(rm, "secant"), fe.tangent_matrix(rm, "algorithmic")
+    assert np.linalg.norm(K_sec @ u - f) <= 1e-12 * np.linalg.norm(f)
+    assert np.linalg.norm(K_alg @ u - f) > 1e-3 * np.linalg.norm(f)
+    with pytest.raises(ValueError, match="tangent"):
+        fe.tangent_matrix(rm, "tangential")
+
+
+def test_secant_start_reaches_the_same_solution():
+    """ContactSettings.secant_start: the first step from the bonded predictor with the
+    secant stiffness, the later ones with the algorithmic tangent (the body's choice
+    restored); Newton converges to the solution of the plain start within the
+    tolerance."""
+    from hpfebe.solvers import newton
+    out = {}
+    for secant in (False, True):
+        pr, steps, _ = _plastic_iterate()
+        steps.settings = ContactSettings(rtol=1e-10, line_search=True, predictor=True,
+                                         secant_start=secant, max_iter=60)
+        x0 = steps.start(np.zeros(pr.ndofs), 1.0)
+        it, info = newton(steps, x0, **steps.newton_options())
+        assert info.converged and info.predictor_used
+        assert pr.bodies["master"].plastic.tangent == "algorithmic"
+        out[secant] = it.x
+    assert np.abs(out[True] - out[False]).max() <= 1e-7 * np.abs(out[False]).max()
+    with pytest.raises(ValueError, match="secant_start"):
+        ContactSettings(secant_start="yes")

@@ -55,6 +55,9 @@ from ..constitutive.j2 import (J2Material, J2State, ReturnMap, dev, radial_retur
                                tangent_factors, tensor_norm, TANGENTS)
 
 FORMULATIONS = ("bbar", "full")
+#: the tangents of the body: the J2 ones (:data:`~hpfebe.constitutive.j2.TANGENTS`) and
+#: "secant" (:meth:`ElastoPlasticFE.tangent_matrix`)
+BODY_TANGENTS = TANGENTS + ("secant",)
 
 
 # The two per-iterate contractions of the body, as loops in the summation order of
@@ -143,11 +146,12 @@ def _elastic_kernel(TR, G, dx, kappa, mu):
 
 @numba.njit(cache=True)
 def _tangent_kernel(Bc, comps, TR, G, dx, Ke_el, pos, nnz, normal, dgamma, safe, plastic,
-                    kappa, mu, H, algorithmic):
+                    kappa, mu, H, algorithmic, secant):
     """The CSR data (nnz,) of the tangent on the pattern of K (``pos[e, i, j]``: the
     position of element entry (i, j) in it): the element matrix (module doc) of every
     element with a plastic point, the elastic one ``Ke_el`` elsewhere (``Bc``, ``comps``:
-    the nonzero components of B, as in :func:`_state_kernel`)."""
+    the nonzero components of B, as in :func:`_state_kernel`).  ``secant``: without the
+    n x n term (theta_bar = 0), the secant stiffness of :meth:`ElastoPlasticFE.tangent_matrix`."""
     ne, nq, nl, nc = Bc.shape
     data = np.zeros(nnz)
     Ke = np.empty((nl, nl))
@@ -165,6 +169,8 @@ def _tangent_kernel(Bc, comps, TR, G, dx, Ke_el, pos, nnz, normal, dgamma, safe,
         for q in range(nq):
             p = e * nq + q
             t1, tb = tangent_factors(dgamma[p], safe[p], plastic[p], mu, H, algorithmic)
+            if secant:
+                tb = 0.0
             for i in range(nl):
                 acc = 0.0
                 for c in range(nc):
@@ -184,7 +190,8 @@ def _tangent_kernel(Bc, comps, TR, G, dx, Ke_el, pos, nnz, normal, dgamma, safe,
 class ElastoPlasticFE:
     """J2 elastoplastic P1/Q1 body.  ``mesh`` (labelled skfem MeshTri/MeshQuad or
     FEDomain), ``material`` (:class:`J2Material`), ``formulation`` ("bbar" or "full"),
-    ``tangent`` ("algorithmic" or "continuum", the tangent returned by internal_force)."""
+    ``tangent`` ("algorithmic", "continuum" or "secant", the tangent returned by
+    internal_force; :meth:`tangent_matrix`)."""
 
     def __init__(self, mesh, material: J2Material, formulation: str = "bbar",
                  tangent: str = "algorithmic"):
@@ -192,7 +199,7 @@ class ElastoPlasticFE:
             mesh = mesh.mesh
         instance("material", material, J2Material)
         choice("formulation", formulation, FORMULATIONS)
-        choice("tangent", tangent, TANGENTS)
+        choice("tangent", tangent, BODY_TANGENTS)
         if isinstance(mesh, MeshQuad):
             elem, order = ElementQuad1(), 2
         elif isinstance(mesh, MeshTri):
@@ -301,8 +308,15 @@ class ElastoPlasticFE:
         full assembly of :func:`~hpfebe.constitutive.j2.consistent_tangent` to round-off;
         the elastic stiffness K itself if no point is plastic).  The pattern is fixed:
         the Newton solver of the contact problems analyses it once
-        (:mod:`hpfebe.contact.newton_matrix`)."""
-        tg = choice("tangent", self.tangent if tangent is None else tangent, TANGENTS)
+        (:mod:`hpfebe.contact.newton_matrix`).  ``tangent`` "secant": the algorithmic
+        tangent without its n x n term, kappa 1 x 1 + 2 mu theta_1 P_dev with theta_1 =
+        1 - 2 mu dgamma / ||eta_trial|| (the stress over the trial stress): the secant
+        stiffness sigma = C_sec eps of a point loaded from a virgin state, stiffer than
+        the algorithmic tangent along n.  Newton's first step from an elastic predictor
+        (every point far past yield, the algorithmic tangent along n about H / (3 mu)
+        soft) takes it (:class:`hpfebe.contact.settings.ContactSettings`
+        ``secant_start``)."""
+        tg = choice("tangent", self.tangent if tangent is None else tangent, BODY_TANGENTS)
         if not rm.plastic.any():
             return self.K
         m = self.material
@@ -310,7 +324,7 @@ class ElastoPlasticFE:
                                self._Ke_el, self._pos, self.K.nnz,
                                np.ascontiguousarray(rm.normal.reshape(-1, 9)), rm.dgamma,
                                rm.eta_norm, rm.plastic, m.kappa, m.mu, m.H,
-                               tg == "algorithmic")
+                               tg != "continuum", tg == "secant")
         # the pattern of K (its index arrays shared): a fixed pattern for the solver
         return sp.csr_matrix((data, self.K.indices, self.K.indptr), shape=self.K.shape)
 

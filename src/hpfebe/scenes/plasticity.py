@@ -224,6 +224,7 @@ class StampingScene:
     bebe_cells: str = "crossed"
     lu_ordering: str = "MMD_AT_PLUS_A"   # sparse LU ordering (ContactSettings)
     ls_refine: int = 3                   # line search refinement (ContactSettings)
+    secant_start: bool = True            # secant first step from the predictor (ContactSettings)
 
     def __post_init__(self):
         choice("lu_ordering", self.lu_ordering, LU_ORDERINGS)
@@ -246,7 +247,8 @@ class StampingScene:
                                 rtol=self.rtol, max_iter=self.max_newton,
                                 max_cuts=self.max_cuts, line_search=True,
                                 predictor=self.predictor, lu_ordering=self.lu_ordering,
-                                ls_refine=self.ls_refine))
+                                ls_refine=self.ls_refine,
+                                secant_start=self.secant_start))
 
     def material(self, theta: float) -> J2Material:
         return J2Material(self.E, self.nu, self.sigma_Y, self.H, theta)
