@@ -138,7 +138,8 @@ def test_bad_input():
     with pytest.raises(ValueError, match="formulation"):
         ElastoPlasticFE(m, MAT, "fbar")
     with pytest.raises(ValueError, match="tangent"):
-        ElastoPlasticFE(m, MAT, tangent="secant")
+        ElastoPlasticFE(m, MAT, tangent="tangential")   # ("secant" is a body tangent)
+    assert ElastoPlasticFE(m, MAT, tangent="secant").tangent == "secant"
     with pytest.raises(ValueError, match="material"):
         ElastoPlasticFE(m, {"E": 1.0})
     with pytest.raises(ValueError, match="mesh"):

@@ -7,6 +7,7 @@ convergence (the :class:`hpfebe.solvers.LoadStep` and
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import warnings
 
@@ -18,6 +19,7 @@ import scipy.sparse.linalg as spla
 from ..checks import array
 from ..solvers import Iterate, SingularStep, SolverInfo
 from ..constitutive.laws import STATE_NAMES, updated_slip
+from ..fem.plastic_body import ElastoPlasticFE
 from .newton_matrix import FixedPatternLU, NewtonMatrix
 from .settings import ContactSettings
 
@@ -63,7 +65,7 @@ class LoadSteps:
         self.x0, self.slip = np.zeros(N), np.zeros(pr.points.shape[0])
         self.f0, self.w0 = np.zeros(N), np.zeros_like(self.slip)
         if initial is not None:
-            self._continue_from(initial)
+            _continue_from(self, initial)
         self.f, self.w = self.f0, self.w0
         # cycling of the contact state is detected with and without a line search (a
         # full-step Newton that cycles reports "cycling", not "max_iter")
@@ -75,25 +77,13 @@ class LoadSteps:
             pr.exact is None and not all(getattr(b, "linear", False)
                                          for b in pr.bodies.values())
         self._newton = None
+        self._predicted = None     # the last bonded predictor (:meth:`step`)
 
     def newton_options(self) -> dict:
         """The keywords of :func:`hpfebe.solvers.newton` for these steps: the
         settings' stopping test and line search, the bonded predictor if asked for."""
         return dict(self.settings.newton_options(),
                     predictor=self.bonded_predictor if self.settings.predictor else None)
-
-    def _continue_from(self, initial) -> None:
-        pr = self.pr
-        if not hasattr(initial, "slip") or initial.U.shape != (pr.ndofs,) or \
-                initial.points.shape != pr.points.shape or \
-                not np.allclose(initial.points, pr.points) or initial.friction != pr.law_name:
-            raise ValueError("initial must be a result of the same bodies, contact points "
-                             "and friction law")
-        if not initial.converged:
-            raise ValueError(f"initial did not converge ({initial.reason}); not a state "
-                             "to continue from")
-        self.x0, self.slip = initial.U.copy(), initial.slip.copy()
-        self.f0, self.w0 = initial.load_vector.copy(), initial.obstacle_motion.copy()
 
     def _load(self, lam: float):
         N, fixed = self.pr.ndofs, self.fixed
@@ -226,6 +216,15 @@ class LoadSteps:
         return lu
 
     def step(self, it: Iterate) -> np.ndarray:
+        """The Newton step at ``it``; at the bonded predictor (``secant_start``) with the
+        secant stiffness of the plastic FE bodies (:func:`_secant_tangents`)."""
+        predicted, self._predicted = self._predicted, None
+        if predicted is not None and it.x is predicted and "K_body" not in it.data:
+            with _secant_tangents(self.pr):
+                return self._newton_step(it)
+        return self._newton_step(it)
+
+    def _newton_step(self, it: Iterate) -> np.ndarray:
         if self.linear_solver == "woodbury":
             law, w = it.data["law"], it.data["weights"]
             return self._solve_woodbury(it.data, w * law.dp_n, w * law.dt_t,
@@ -305,11 +304,13 @@ class LoadSteps:
                 return None
         if self.fixed_pattern:
             try:
-                return it.x + self._solve_fixed(cs, w * ones / pr.eps_n,
-                                                w * ones / pr.eps_t, 0.0 * w,
-                                                -Rb[self.free])
+                x = it.x + self._solve_fixed(cs, w * ones / pr.eps_n, w * ones / pr.eps_t,
+                                             0.0 * w, -Rb[self.free])
             except SingularStep:
                 return None
+            if self.settings.secant_start:
+                self._predicted = x       # the first step from it: secant (:meth:`step`)
+            return x
         C = Gn.T @ sp.diags(w * ones / pr.eps_n) @ Gn \
             + Gt.T @ sp.diags(w * ones / pr.eps_t) @ Gt
         K = cs["K_body"]
@@ -318,6 +319,44 @@ class LoadSteps:
             return it.x + self._solve(A, -Rb[self.free])
         except SingularStep:
             return None
+
+
+def _continue_from(self, initial) -> None:
+    """LoadSteps ``self`` from the converged result ``initial`` (U, slip, load and
+    obstacle motion)."""
+    pr = self.pr
+    if not hasattr(initial, "slip") or initial.U.shape != (pr.ndofs,) or \
+            initial.points.shape != pr.points.shape or \
+            not np.allclose(initial.points, pr.points) or initial.friction != pr.law_name:
+        raise ValueError("initial must be a result of the same bodies, contact points "
+                         "and friction law")
+    if not initial.converged:
+        raise ValueError(f"initial did not converge ({initial.reason}); not a state "
+                         "to continue from")
+    self.x0, self.slip = initial.U.copy(), initial.slip.copy()
+    self.f0, self.w0 = initial.load_vector.copy(), initial.obstacle_motion.copy()
+
+
+@contextlib.contextmanager
+def _secant_tangents(pr):
+    """The elastoplastic FE bodies of the contact problem ``pr`` return their secant
+    stiffness (:meth:`hpfebe.fem.plastic_body.ElastoPlasticFE.tangent_matrix`) inside
+    the block, their own tangent after.  For the step at the bonded predictor, an
+    elastic solution whose plastic points lie far past yield: there the algorithmic
+    tangent is about H / (3 mu) soft along the flow direction and its step overshoots
+    (a line search of many small steps followed); the secant step is that of the
+    deformation-theory material through the trial state.  (The iterate's tangent is
+    assembled lazily, on its first access inside the block.)"""
+    bodies = [b.plastic for b in pr.bodies.values()
+              if isinstance(getattr(b, "plastic", None), ElastoPlasticFE)]
+    kept = [b.tangent for b in bodies]
+    try:
+        for b in bodies:
+            b.tangent = "secant"
+        yield
+    finally:
+        for b, t in zip(bodies, kept):
+            b.tangent = t
 
 
 #: column orderings of the sparsity patterns met (:func:`_ordered_splu`), at most

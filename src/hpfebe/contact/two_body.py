@@ -153,6 +153,35 @@ def _csr_block_diag(A: sp.csr_matrix, B: sp.csr_matrix) -> sp.csr_matrix:
     return sp.csr_matrix((data, indices, indptr), shape=(n + B.shape[0], m + B.shape[1]))
 
 
+class _BlockDiagonal:
+    """:func:`_csr_block_diag` of two body tangents, its index arrays reused while both
+    tangents keep their patterns (a plastic body's tangent at every state has the pattern
+    of its stiffness), so that a Newton step of a plastic body concatenates the values
+    only."""
+
+    def __init__(self):
+        self.last = None     # (A.indices, A.indptr, B.indices, B.indptr, block diagonal)
+
+    def __call__(self, A: sp.csr_matrix, B: sp.csr_matrix) -> sp.csr_matrix:
+        last = self.last
+        if last is not None and A.data.dtype == B.data.dtype == np.float64 and all(
+                _same_array(a, b) for a, b in zip(last[:4], (A.indices, A.indptr,
+                                                            B.indices, B.indptr))):
+            out = last[4]
+            return sp.csr_matrix((np.concatenate([A.data, B.data]), out.indices,
+                                  out.indptr), shape=out.shape)
+        out = _csr_block_diag(A, B)
+        self.last = (A.indices.copy(), A.indptr.copy(), B.indices.copy(), B.indptr.copy(),
+                     out)
+        return out
+
+
+def _same_array(a: np.ndarray, b: np.ndarray) -> bool:
+    """a and b hold the same numbers (equal shapes and entries; scipy's constructors
+    return new array objects, often views, for the index arrays they are given)."""
+    return a.shape == b.shape and a.dtype == b.dtype and np.array_equal(a, b)
+
+
 class _State(dict):
     """The contact state of :meth:`TwoBodyContact.internal_force`: a dict whose entries
     in ``lazy`` (key -> callable) are computed on first access."""
@@ -411,7 +440,9 @@ class TwoBodyContact:
         elif self.dense:
             out = sla.block_diag(Ks, Km)
         else:
-            out = _csr_block_diag(sp.csr_matrix(Ks), sp.csr_matrix(Km))
+            if getattr(self, "_block_pattern", None) is None:
+                self._block_pattern = _BlockDiagonal()
+            out = self._block_pattern(sp.csr_matrix(Ks), sp.csr_matrix(Km))
         self._blocks_last = (Ks, Km, out)
         return out
 

@@ -55,6 +55,9 @@ from ..constitutive.j2 import (J2Material, J2State, ReturnMap, dev, radial_retur
                                tangent_factors, tensor_norm, TANGENTS)
 
 FORMULATIONS = ("bbar", "full")
+#: the tangents of the body: the J2 ones (:data:`~hpfebe.constitutive.j2.TANGENTS`) and
+#: "secant" (:meth:`ElastoPlasticFE.tangent_matrix`)
+BODY_TANGENTS = TANGENTS + ("secant",)
 
 
 # The two per-iterate contractions of the body, as loops in the summation order of
@@ -94,32 +97,35 @@ def _force_kernel(B, s, dx):
 
 
 @numba.njit(cache=True)
-def _state_kernel(B, ue, dx, ep, alpha, beta, mu, kappa, H, theta, sigma_Y):
+def _state_kernel(Bc, comps, ue, dx, ep, alpha, beta, mu, kappa, H, theta, sigma_Y):
     """Strain eps = B ue, the radial return from the committed (ep, alpha, beta) (all
     (nel * nq, ...)), the stress and the element forces fe[e, i] = sum_q sum_a
-    B[e, q, i, a] sigma[e, q, a] dx[e, q] in one pass over the elements."""
-    ne, nq, nl, na = B.shape
+    B[e, q, i, a] sigma[e, q, a] dx[e, q] in one pass over the elements.  ``Bc`` holds
+    the components ``comps`` of B (the others vanish: :attr:`ElastoPlasticFE._comps`),
+    so the sums skip exact zeros only: the numbers of the full 9-component sums."""
+    ne, nq, nl, nc = Bc.shape
     n = ne * nq
     sigma, ep_new, beta_new = np.empty((n, 9)), np.empty((n, 9)), np.empty((n, 9))
     normal = np.empty((n, 9))
     alpha_new, dgamma, f_trial, safe = np.empty(n), np.empty(n), np.empty(n), np.empty(n)
     fe = np.zeros((ne, nl))
-    eps = np.empty(9)
+    eps = np.zeros(9)
     for e in range(ne):
         for q in range(nq):
             p = e * nq + q
-            for a in range(na):
+            for c in range(nc):
                 acc = 0.0
                 for i in range(nl):
-                    acc += B[e, q, i, a] * ue[e, i]
-                eps[a] = acc
+                    acc += Bc[e, q, i, c] * ue[e, i]
+                eps[comps[c]] = acc
             alpha_new[p], dgamma[p], f_trial[p], safe[p] = radial_return_point(
                 eps, ep[p], alpha[p], beta[p], mu, kappa, H, theta, sigma_Y,
                 sigma[p], ep_new[p], beta_new[p], normal[p])
+            w = dx[e, q]
             for i in range(nl):
                 acc = 0.0
-                for a in range(na):
-                    acc += B[e, q, i, a] * sigma[p, a] * dx[e, q]
+                for c in range(nc):
+                    acc += Bc[e, q, i, c] * sigma[p, comps[c]] * w
                 fe[e, i] += acc
     return sigma, ep_new, alpha_new, beta_new, normal, dgamma, f_trial, safe, fe
 
@@ -139,12 +145,14 @@ def _elastic_kernel(TR, G, dx, kappa, mu):
 
 
 @numba.njit(cache=True)
-def _tangent_kernel(B, TR, G, dx, Ke_el, pos, nnz, normal, dgamma, safe, plastic,
-                    kappa, mu, H, algorithmic):
+def _tangent_kernel(Bc, comps, TR, G, dx, Ke_el, pos, nnz, normal, dgamma, safe, plastic,
+                    kappa, mu, H, algorithmic, secant):
     """The CSR data (nnz,) of the tangent on the pattern of K (``pos[e, i, j]``: the
     position of element entry (i, j) in it): the element matrix (module doc) of every
-    element with a plastic point, the elastic one ``Ke_el`` elsewhere."""
-    ne, nq, nl, na = B.shape
+    element with a plastic point, the elastic one ``Ke_el`` elsewhere (``Bc``, ``comps``:
+    the nonzero components of B, as in :func:`_state_kernel`).  ``secant``: without the
+    n x n term (theta_bar = 0), the secant stiffness of :meth:`ElastoPlasticFE.tangent_matrix`."""
+    ne, nq, nl, nc = Bc.shape
     data = np.zeros(nnz)
     Ke = np.empty((nl, nl))
     m = np.empty(nl)
@@ -161,10 +169,12 @@ def _tangent_kernel(B, TR, G, dx, Ke_el, pos, nnz, normal, dgamma, safe, plastic
         for q in range(nq):
             p = e * nq + q
             t1, tb = tangent_factors(dgamma[p], safe[p], plastic[p], mu, H, algorithmic)
+            if secant:
+                tb = 0.0
             for i in range(nl):
                 acc = 0.0
-                for a in range(na):
-                    acc += normal[p, a] * B[e, q, i, a]
+                for c in range(nc):
+                    acc += normal[p, comps[c]] * Bc[e, q, i, c]
                 m[i] = acc
             for i in range(nl):
                 for j in range(nl):
@@ -180,7 +190,8 @@ def _tangent_kernel(B, TR, G, dx, Ke_el, pos, nnz, normal, dgamma, safe, plastic
 class ElastoPlasticFE:
     """J2 elastoplastic P1/Q1 body.  ``mesh`` (labelled skfem MeshTri/MeshQuad or
     FEDomain), ``material`` (:class:`J2Material`), ``formulation`` ("bbar" or "full"),
-    ``tangent`` ("algorithmic" or "continuum", the tangent returned by internal_force)."""
+    ``tangent`` ("algorithmic", "continuum" or "secant", the tangent returned by
+    internal_force; :meth:`tangent_matrix`)."""
 
     def __init__(self, mesh, material: J2Material, formulation: str = "bbar",
                  tangent: str = "algorithmic"):
@@ -188,7 +199,7 @@ class ElastoPlasticFE:
             mesh = mesh.mesh
         instance("material", material, J2Material)
         choice("formulation", formulation, FORMULATIONS)
-        choice("tangent", tangent, TANGENTS)
+        choice("tangent", tangent, BODY_TANGENTS)
         if isinstance(mesh, MeshQuad):
             elem, order = ElementQuad1(), 2
         elif isinstance(mesh, MeshTri):
@@ -202,6 +213,11 @@ class ElastoPlasticFE:
         self.dx = self.basis.dx                                   # (nel, nq)
         self.nel, self.nq = self.dx.shape
         self.B = np.ascontiguousarray(self._strain_operator())    # (nel, nq, nloc, 9)
+        # the components of the strain that B can make nonzero (plane strain: xx, xy,
+        # yx, yy and, with B-bar, zz): the kernels sum over these only (the other
+        # terms are exact zeros), on a compact copy of B (5/9 of the memory traffic)
+        self._comps = np.flatnonzero(np.any(self.B != 0.0, axis=(0, 1, 2))).astype(np.int64)
+        self._Bc = np.ascontiguousarray(self.B[..., self._comps])
         self._dx_c = np.ascontiguousarray(self.dx, dtype=float)
         dofs = self.basis.element_dofs                            # (nloc, nel)
         self.element_dofs = dofs
@@ -292,16 +308,23 @@ class ElastoPlasticFE:
         full assembly of :func:`~hpfebe.constitutive.j2.consistent_tangent` to round-off;
         the elastic stiffness K itself if no point is plastic).  The pattern is fixed:
         the Newton solver of the contact problems analyses it once
-        (:mod:`hpfebe.contact.newton_matrix`)."""
-        tg = choice("tangent", self.tangent if tangent is None else tangent, TANGENTS)
+        (:mod:`hpfebe.contact.newton_matrix`).  ``tangent`` "secant": the algorithmic
+        tangent without its n x n term, kappa 1 x 1 + 2 mu theta_1 P_dev with theta_1 =
+        1 - 2 mu dgamma / ||eta_trial|| (the stress over the trial stress): the secant
+        stiffness sigma = C_sec eps of a point loaded from a virgin state, stiffer than
+        the algorithmic tangent along n.  Newton's first step from an elastic predictor
+        (every point far past yield, the algorithmic tangent along n about H / (3 mu)
+        soft) takes it (:class:`hpfebe.contact.settings.ContactSettings`
+        ``secant_start``)."""
+        tg = choice("tangent", self.tangent if tangent is None else tangent, BODY_TANGENTS)
         if not rm.plastic.any():
             return self.K
         m = self.material
-        data = _tangent_kernel(self.B, self._TR, self._G, self._dx_c, self._Ke_el,
-                               self._pos, self.K.nnz,
+        data = _tangent_kernel(self._Bc, self._comps, self._TR, self._G, self._dx_c,
+                               self._Ke_el, self._pos, self.K.nnz,
                                np.ascontiguousarray(rm.normal.reshape(-1, 9)), rm.dgamma,
                                rm.eta_norm, rm.plastic, m.kappa, m.mu, m.H,
-                               tg == "algorithmic")
+                               tg != "continuum", tg == "secant")
         # the pattern of K (its index arrays shared): a fixed pattern for the solver
         return sp.csr_matrix((data, self.K.indices, self.K.indptr), shape=self.K.shape)
 
@@ -330,7 +353,8 @@ class ElastoPlasticFE:
         m, c, n = self.material, self.committed, self.n_points
         ue = np.ascontiguousarray(u[self.element_dofs].T)
         sigma, ep, alpha, beta, normal, dgamma, f_trial, safe, fe = _state_kernel(
-            self.B, ue, self._dx_c, np.ascontiguousarray(c.eps_p.reshape(n, 9)),
+            self._Bc, self._comps, ue, self._dx_c,
+            np.ascontiguousarray(c.eps_p.reshape(n, 9)),
             np.ascontiguousarray(c.alpha), np.ascontiguousarray(c.beta.reshape(n, 9)),
             m.mu, m.kappa, m.H, m.theta, m.sigma_Y)
         t = (n, 3, 3)

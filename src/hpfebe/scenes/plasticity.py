@@ -63,7 +63,10 @@ CHOICES = (
     "states (at the first unloading increment, and after an increment that ended with "
     "the contact open: the work piece moved rigidly, the stamp at rest, no predictor "
     "while no point is in contact), or from TwoBodyContact's bonded predictor when that "
-    "lowers ||R|| (tried in the first two increments of a touch only); Armijo line search on ||R|| (an accepted step below 1 halved further "
+    "lowers ||R|| (tried in the first two increments of a touch only; the first step "
+    "from it with the work piece's secant stiffness, secant_start: the algorithmic "
+    "tangent at that elastic state is about H/(3 mu) soft along the flow direction); "
+    "Armijo line search on ||R|| (an accepted step below 1 halved further "
     "while ||R|| decreases, ls_refine = 3 times at most; at most max_newton = 60 "
     "iterations), stop at ||R|| <= rtol x force scale + rtol x the reference "
     "force (the work piece's width times the smaller of sigma_Y and the elastic stress of "
@@ -224,6 +227,7 @@ class StampingScene:
     bebe_cells: str = "crossed"
     lu_ordering: str = "MMD_AT_PLUS_A"   # sparse LU ordering (ContactSettings)
     ls_refine: int = 3                   # line search refinement (ContactSettings)
+    secant_start: bool = True            # secant first step from the predictor (ContactSettings)
 
     def __post_init__(self):
         choice("lu_ordering", self.lu_ordering, LU_ORDERINGS)
@@ -246,7 +250,8 @@ class StampingScene:
                                 rtol=self.rtol, max_iter=self.max_newton,
                                 max_cuts=self.max_cuts, line_search=True,
                                 predictor=self.predictor, lu_ordering=self.lu_ordering,
-                                ls_refine=self.ls_refine))
+                                ls_refine=self.ls_refine,
+                                secant_start=self.secant_start))
 
     def material(self, theta: float) -> J2Material:
         return J2Material(self.E, self.nu, self.sigma_Y, self.H, theta)
