@@ -26,6 +26,9 @@ def main(argv: list[str]) -> None:
               f"a={r['a']:.6f} (Hertz {r['a_hertz']:.6f}, err {r['err_a']:.3e}) "
               f"p0={r['p0']:.2f} (Hertz {r['p0_hertz']:.2f}, err {r['err_p0']:.3e}) "
               f"F={r['F']:.4f}", flush=True)
+        print("  gmres per Newton step:", r["gmres_per_step"], flush=True)
+        print("  cpu split: " + ", ".join(f"{k}={v:.1f}" for k, v in r["times"].items()),
+              flush=True)
 
 
 if __name__ == "__main__":

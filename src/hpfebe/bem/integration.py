@@ -118,7 +118,7 @@ def _seg_dist(ax, ay, bx, by, cx, cy, dx, dy):
         else:
             px, py, qx, qy, ux, uy = dx, dy, ax, ay, bx - ax, by - ay
         uu = ux * ux + uy * uy
-        t = ((px - qx) * ux + (py - qy) * uy) / uu
+        t = ((px - qx) * ux + (py - qy) * uy) / uu if uu > 0.0 else 0.0
         t = min(1.0, max(0.0, t))
         ex = px - qx - t * ux
         ey = py - qy - t * uy
@@ -208,6 +208,11 @@ def far_block(kernel, logc, haslog, kp, d, aI, bI, nI, aJ, bJ, nJ, s0, s1, g0, g
         u0, u1, v0, v1 = stack[top, 0], stack[top, 1], stack[top, 2], stack[top, 3]
         hx = (u1 - u0) * LI
         hy = (v1 - v0) * LJ
+        if hx <= 0.0 or hy <= 0.0:
+            # a piece of zero measure (no contribution): the remainder of an adjacent
+            # pair whose lengths differ by rounding only, halved below the spacing of
+            # the doubles (N >= 8192 on a circle: the Duffy square leaves ~1e-13 L)
+            continue
         nx = 0
         if whole:
             # well separated pair (the common case): midpoint distance minus the half

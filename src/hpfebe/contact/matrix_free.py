@@ -50,13 +50,15 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 from numba import njit
 
-from ..checks import array, integer, real
+from ..checks import array, choice, integer, real
 from ..solvers import SolverInfo
+from .mixed_precond import PrimalMultilevel
 
 __all__ = ["MixedPenaltyResult", "PenaltyP1", "near_field", "solve_penalty_mixed"]
 
 ARMIJO = 1e-4
 MIN_STEP = 2.0 ** -30
+PRECONDITIONERS = ("multilevel", "near_field")
 GAUSS2 = np.array([0.5 - 0.5 / np.sqrt(3.0), 0.5 + 0.5 / np.sqrt(3.0)])
 
 
@@ -253,7 +255,7 @@ class _MixedSystem:
     products A0 Z (once), the mixed operator and each Newton step's preconditioner."""
 
     def __init__(self, bem, gap, dirichlet_displacement, load, contact_label,
-                 dirichlet_label, coarse):
+                 dirichlet_label, coarse, preconditioner="multilevel"):
         hm = getattr(bem, "hm", None)
         if hm is None:
             raise ValueError("bem: solve_penalty_mixed needs a LameBEM with "
@@ -289,6 +291,10 @@ class _MixedSystem:
         Wn = (hm.S.T @ near_field(hm.hmatrix("W")) @ hm.S).tocsr()
         self.Wff, self.Bf = Wn[self.free][:, self.free], Bn[:, self.free]
         self.t_near = time.process_time() - t0
+        self.kind = preconditioner
+        if preconditioner == "multilevel":
+            self._multilevel(bem, hm)
+            return
         # coarse space of the deflated preconditioner: A0 Z once (H-matrix products)
         t0 = time.process_time()
         self.Z = None
@@ -298,6 +304,20 @@ class _MixedSystem:
             self.Zuf = Zuf[:, np.flatnonzero(np.diff(Zuf.tocsc().indptr))]  # not in Gamma_D
             self.Z = sp.block_diag([self.Zuf, Zp], format="csr")
             self.AZ0 = self.mixed0(self.Z.toarray())
+        self.t_coarse = time.process_time() - t0
+
+    def _multilevel(self, bem, hm):
+        """The block-diagonal multilevel preconditioner (:mod:`.mixed_precond`)."""
+        t0 = time.process_time()
+        mesh = bem.mesh
+        pos = np.empty(bem.V_space.ndof, np.int64)
+        pos[bem.V_space.elem_dofs[:, 0]] = np.arange(len(mesh.elements))
+        self.PA = PrimalMultilevel(
+            lambda X: self.W @ X, self.Wff, self.free, self.n,
+            lambda chunk: coarse_space(mesh, bem.V_space, bem.W_space, chunk)[0],
+            pos[self.free // 2], len(mesh.elements))
+        self.PV = hm.preconditioner_V()
+        self.perm_W = hm.perm_W
         self.t_coarse = time.process_time() - t0
 
     def start(self) -> np.ndarray:
@@ -359,7 +379,20 @@ class _MixedSystem:
 
     def preconditioner(self, Cff):
         """The near-field LU of [[W + C_eps, B^T], [B, -V]], deflated by the coarse space
-        (ADEF1: Z w + M0^{-1} (r - A Z w), w = (Z^T A Z)^{-1} Z^T r)."""
+        (ADEF1: Z w + M0^{-1} (r - A Z w), w = (Z^T A Z)^{-1} Z^T r); or the block-
+        triangular multilevel [[P_A, 0], [B, -P_V]] of :mod:`.mixed_precond`."""
+        if self.kind == "multilevel":
+            solve_A, nf, perm = self.PA.update(Cff), self.nf, self.perm_W
+            B, free, n = self.B, self.free, self.n
+
+            def block_triangular(r):           # P = [[P_A, 0], [B, -P_V]]
+                y = np.empty_like(r)
+                y[:nf] = solve_A(r[:nf])
+                du = np.zeros(n)
+                du[free] = y[:nf]
+                y[nf:][perm] = self.PV.solve((B @ du - r[nf:])[perm])
+                return y
+            return block_triangular
         P = sp.bmat([[self.Wff + Cff, self.Bf.T], [self.Bf, -self.Vn]], format="csc")
         lu = spla.splu(P, permc_spec="COLAMD")
         if self.Z is None:
@@ -399,7 +432,8 @@ def solve_penalty_mixed(bem, eps: float, gap, dirichlet_displacement=(0.0, 0.0),
                         load=None, contact_label: str = "C", dirichlet_label: str = "D",
                         tol: float = 1e-8, max_iter: int = 50,
                         gmres_tol: float | None = None, restart: int = 200,
-                        gmres_maxiter: int = 5, coarse: int | None = 16
+                        gmres_maxiter: int = 5, coarse: int | None = 16,
+                        preconditioner: str = "multilevel"
                         ) -> MixedPenaltyResult:
     """Penalty contact (3.45)-(3.46) of a compressed :class:`LameBEM` body (module doc).
 
@@ -426,8 +460,9 @@ def solve_penalty_mixed(bem, eps: float, gap, dirichlet_displacement=(0.0, 0.0),
     restart = integer("restart", restart, lo=1)
     gmres_maxiter = integer("gmres_maxiter", gmres_maxiter, lo=1)
     coarse = integer("coarse", coarse, lo=1, allow_none=True)
+    preconditioner = choice("preconditioner", preconditioner, PRECONDITIONERS)
     sysm = _MixedSystem(bem, gap, dirichlet_displacement, load, contact_label,
-                        dirichlet_label, coarse)
+                        dirichlet_label, coarse, preconditioner)
     n, free, f, pen = sysm.n, sysm.free, sysm.f, sysm.pen
     U, psi = sysm.start(), np.zeros(sysm.m)
     info = SolverInfo(converged=False, reason="")

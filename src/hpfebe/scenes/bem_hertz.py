@@ -114,13 +114,20 @@ def solve(run: HertzRun, compression: str | None = "hmatrix") -> dict:
         res = solve_penalty(bem, run.eps, gap, load=-(S @ lift), S=S, tol=1e-12)
         U, converged, its = res.U + lift, res.converged, res.iterations
         pen = PenaltyP1(mesh, bem.V_space, np.flatnonzero(mesh.where("C")), gap)
-        extra = dict(gmres_iterations=0, backward_error=np.nan, reason=res.reason)
+        extra = dict(gmres_iterations=0, backward_error=np.nan, reason=res.reason,
+                     gmres_per_step=[], times={})
     else:
         bem = LameBEM(mesh, E, NU, zero_force=False, compression=compression, tol=run.tol)
+        t1 = time.process_time()
+        for name in ("V", "K", "W"):
+            bem.hm.hmatrix(name)
+        assembly = time.process_time() - t1
         res = solve_penalty_mixed(bem, run.eps, gap, (0.0, -run.delta), tol=run.tol)
         U, converged, its, pen = res.U, res.converged, res.iterations, res.contact
         extra = dict(gmres_iterations=int(sum(res.gmres_iterations)),
-                     backward_error=max(res.backward_errors), reason=res.reason)
+                     backward_error=max(res.backward_errors), reason=res.reason,
+                     gmres_per_step=list(res.gmres_iterations),
+                     times=dict(assembly_s=assembly, **res.times))
     cpu = time.process_time() - t0
     xs = pen.half_width(U)
     if xs is None:
