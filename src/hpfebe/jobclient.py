@@ -1,5 +1,5 @@
 """The client side of the local job server (:mod:`hpfebe.jobserver`): standard
-library only, so that ``python -m hpfebe`` decides in a few milliseconds whether a
+library only (and :mod:`hpfebe.suite.watch`, which is too), so that ``python -m hpfebe`` decides in a few milliseconds whether a
 server of the same tree and environment will run the command.
 
 ``python -m hpfebe ARGS`` with ``HPFEBE_JOBSERVER`` set (the workflow sets it for its
@@ -24,22 +24,14 @@ import struct
 import sys
 import time
 
+from .suite.watch import pid_exists     # (standard library only, as this module)
+
 #: the socket of the server, and its pid (while it starts, the socket is not there yet)
 ENV_SOCKET = "HPFEBE_JOBSERVER"
 ENV_PID = "HPFEBE_JOBSERVER_PID"
 #: how long a client waits for a server that is still starting (imports: about 2 s)
 START_WAIT_S = 60.0
 FORWARDED = (signal.SIGTERM, signal.SIGINT, signal.SIGHUP)
-
-
-def _alive(pid: int) -> bool:
-    try:
-        os.kill(pid, 0)
-    except ProcessLookupError:
-        return False
-    except PermissionError:
-        return True
-    return True
 
 
 def _connect(path: str, pid: int | None) -> socket.socket | None:
@@ -52,7 +44,7 @@ def _connect(path: str, pid: int | None) -> socket.socket | None:
             return s
         except OSError:
             s.close()
-        if pid is None or not _alive(pid) or time.monotonic() > deadline:
+        if pid is None or not pid_exists(pid) or time.monotonic() > deadline:
             return None
         time.sleep(0.02)
 

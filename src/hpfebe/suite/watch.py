@@ -90,6 +90,11 @@ def _alive(pid: int, start: str | None) -> bool:
     zombie (killed, not yet reaped by its parent) counts as ended."""
     if os.path.isdir("/proc"):
         return start is not None and _start_time(pid) == start
+    return pid_exists(pid)
+
+
+def pid_exists(pid: int) -> bool:
+    """A process ``pid`` exists (signal 0; one of another user counts too)."""
     try:
         os.kill(pid, 0)
     except ProcessLookupError:
