@@ -575,13 +575,36 @@ def main(argv: list[str] | None = None) -> int:
         print("hpfebe: interrupted (no result file was left half written)", file=sys.stderr)
         return 130
     except Terminated as exc:
-        why = f": {exc.why}" if exc.why else ""
-        print(f"hpfebe: terminated by signal {exc.signum}{why} (no result file was left "
-              "half written)", file=sys.stderr)
-        return 128 + exc.signum
-    except Exception:
+        return _terminated(exc)
+    except Exception as exc:
+        cause = _terminated_cause(exc)
+        if cause is not None:     # raised inside a compiled kernel's callback
+            return _terminated(cause)
         log.exception("hpfebe %s failed", args.command)
         return EXIT_FAILED
+
+
+def _terminated(exc: Terminated) -> int:
+    from .suite.results import remove_temporaries
+
+    remove_temporaries()
+    why = f": {exc.why}" if exc.why else ""
+    print(f"hpfebe: terminated by signal {exc.signum}{why} (no result file was left "
+          "half written)", file=sys.stderr)
+    return 128 + exc.signum
+
+
+def _terminated_cause(exc: BaseException):
+    """The Terminated behind ``exc``: the signal handler's exception, raised while a
+    numba kernel called back into Python (unpickling a constant), reaches Python as a
+    SystemError whose context is the Terminated."""
+    seen = set()
+    while exc is not None and id(exc) not in seen:
+        if isinstance(exc, Terminated):
+            return exc
+        seen.add(id(exc))
+        exc = exc.__cause__ or exc.__context__
+    return None
 
 
 if __name__ == "__main__":  # pragma: no cover

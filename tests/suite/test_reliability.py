@@ -411,3 +411,20 @@ def test_job_of_a_dead_snakemake_does_not_start(tmp_path):
                        capture_output=True, text=True, timeout=120)
     assert r.returncode == 2 and "has ended" in r.stderr, r.stderr
     assert not (tmp_path / "out").exists()
+
+
+def test_a_signal_inside_a_compiled_kernel_is_still_a_termination():
+    """SIGTERM's Terminated raised while numba called back into Python reaches the CLI as
+    a SystemError caused by it: found in the chain (exit 128 + signal, not 1)."""
+    from hpfebe.cli import _terminated_cause
+    from hpfebe.suite.watch import Terminated
+
+    try:
+        try:
+            raise Terminated(15)
+        except Terminated as inner:
+            raise SystemError("returned a result with an exception set") from inner
+    except SystemError as exc:
+        found = _terminated_cause(exc)
+    assert isinstance(found, Terminated) and found.signum == 15
+    assert _terminated_cause(ValueError("other")) is None
