@@ -73,3 +73,16 @@ def remove_stale(keep: int = 3) -> list[Path]:
     for d in stale:
         shutil.rmtree(d, ignore_errors=True)
     return stale
+
+
+def host_key() -> dict:
+    """What numba's cached machine code depends on besides the sources (the digest
+    directory's name): the interpreter, numba and the CPU it was compiled for."""
+    import platform
+
+    import llvmlite.binding as llvm
+    import numba
+
+    return {"python": platform.python_version(), "numba": numba.__version__,
+            "cpu": llvm.get_host_cpu_name(), "features": llvm.get_host_cpu_features()
+            .flatten()}

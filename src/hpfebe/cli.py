@@ -18,7 +18,7 @@ import time
 from pathlib import Path
 
 from .suite.published import published_file_for
-from .suite.watch import (ParentGone, Terminated, install_signal_handlers,
+from .suite.watch import (ParentGone, Terminated, install_signal_handlers, terminated_cause,
                           watch_parent_from_env)
 
 log = logging.getLogger("hpfebe")
@@ -446,19 +446,6 @@ def cmd_report(args) -> int:
     return EXIT_OK
 
 
-def _host_key() -> dict:
-    """What numba's cached machine code depends on besides the sources (the digest
-    directory's name): the interpreter, numba and the CPU it was compiled for."""
-    import platform
-
-    import llvmlite.binding as llvm
-    import numba
-
-    return {"python": platform.python_version(), "numba": numba.__version__,
-            "cpu": llvm.get_host_cpu_name(), "features": llvm.get_host_cpu_features()
-            .flatten()}
-
-
 def cmd_compile(args) -> int:
     """Compile (or load from numba's cache) every numba kernel once; with --stamp FILE,
     record the times in FILE (JSON, written atomically: the workflow's numba_cache rule).
@@ -471,7 +458,7 @@ def cmd_compile(args) -> int:
     from .suite.warmup import compile_kernels
 
     cache = Path(os.environ[_numba_cache.ENV])
-    ready, key = cache / "ready.json", _host_key()
+    ready, key = cache / "ready.json", _numba_cache.host_key()
     try:
         done = not args.force and json.loads(ready.read_text()) == key
     except (OSError, ValueError):
@@ -577,7 +564,7 @@ def main(argv: list[str] | None = None) -> int:
     except Terminated as exc:
         return _terminated(exc)
     except Exception as exc:
-        cause = _terminated_cause(exc)
+        cause = terminated_cause(exc)
         if cause is not None:     # raised inside a compiled kernel's callback
             return _terminated(cause)
         log.exception("hpfebe %s failed", args.command)
@@ -593,18 +580,6 @@ def _terminated(exc: Terminated) -> int:
           "half written)", file=sys.stderr)
     return 128 + exc.signum
 
-
-def _terminated_cause(exc: BaseException):
-    """The Terminated behind ``exc``: the signal handler's exception, raised while a
-    numba kernel called back into Python (unpickling a constant), reaches Python as a
-    SystemError whose context is the Terminated."""
-    seen = set()
-    while exc is not None and id(exc) not in seen:
-        if isinstance(exc, Terminated):
-            return exc
-        seen.add(id(exc))
-        exc = exc.__cause__ or exc.__context__
-    return None
 
 
 if __name__ == "__main__":  # pragma: no cover

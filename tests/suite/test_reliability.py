@@ -416,7 +416,7 @@ def test_job_of_a_dead_snakemake_does_not_start(tmp_path):
 def test_a_signal_inside_a_compiled_kernel_is_still_a_termination():
     """SIGTERM's Terminated raised while numba called back into Python reaches the CLI as
     a SystemError caused by it: found in the chain (exit 128 + signal, not 1)."""
-    from hpfebe.cli import _terminated_cause
+    from hpfebe.suite.watch import terminated_cause as _terminated_cause
     from hpfebe.suite.watch import Terminated
 
     try:

@@ -246,3 +246,16 @@ def before_rename(path) -> None:
         if gone():
             log.warning("%s: %s not written, stopping this run", why, path)
             raise Terminated(signal.SIGTERM, f"{why}: {path} was not written")
+
+
+def terminated_cause(exc: BaseException):
+    """The Terminated behind ``exc``: the signal handler's exception, raised while a
+    numba kernel called back into Python (unpickling a constant), reaches Python as a
+    SystemError whose context is the Terminated."""
+    seen = set()
+    while exc is not None and id(exc) not in seen:
+        if isinstance(exc, Terminated):
+            return exc
+        seen.add(id(exc))
+        exc = exc.__cause__ or exc.__context__
+    return None
