@@ -75,6 +75,25 @@ def remove_stale(keep: int = 3) -> list[Path]:
     return stale
 
 
+def source_stamps(package: Path = PACKAGE) -> list:
+    """numba's freshness stamp of every file of the package that uses numba: (path,
+    mtime, size).  numba keeps a cached kernel only while its file's stamp is the one it
+    was compiled with, so a fresh checkout of the same sources (same digest directory,
+    new mtimes) recompiles everything: the ready mark must know it."""
+    out = []
+    for path in sorted(package.rglob("*.py")):
+        if b"numba" in path.read_bytes():
+            st = path.stat()
+            out.append([str(path.relative_to(package)), st.st_mtime, st.st_size])
+    return out
+
+
+def ready_key() -> dict:
+    """What ``hpfebe compile``'s ready mark records: the host, this checkout and its
+    sources' stamps (two checkouts of one tree share the digest directory)."""
+    return {**host_key(), "package": str(PACKAGE), "stamps": source_stamps()}
+
+
 def host_key() -> dict:
     """What numba's cached machine code depends on besides the sources (the digest
     directory's name): the interpreter, numba and the CPU it was compiled for."""

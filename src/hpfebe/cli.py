@@ -450,15 +450,15 @@ def cmd_compile(args) -> int:
     """Compile (or load from numba's cache) every numba kernel once; with --stamp FILE,
     record the times in FILE (JSON, written atomically: the workflow's numba_cache rule).
     A complete warm-up leaves ``ready.json`` in the cache directory of this source tree:
-    a later call on the same host finds it and returns at once (``--force`` runs the
-    warm-up again; a kernel missing from the cache would still compile where it is
-    called, as without the warm-up)."""
+    a later call on the same host and the same checkout (numba's source stamps) finds it
+    and returns at once (``--force`` runs the warm-up again; a kernel missing from the
+    cache would still compile where it is called, as without the warm-up)."""
     from . import _numba_cache
     from .suite.results import atomic_write
     from .suite.warmup import compile_kernels
 
     cache = Path(os.environ[_numba_cache.ENV])
-    ready, key = cache / "ready.json", _numba_cache.host_key()
+    ready, key = cache / "ready.json", _numba_cache.ready_key()
     try:
         done = not args.force and json.loads(ready.read_text()) == key
     except (OSError, ValueError):

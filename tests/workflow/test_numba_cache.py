@@ -51,3 +51,14 @@ def test_remove_stale_keeps_the_newest(tmp_path, monkeypatch):
         os.utime(d, (1000 + k, 1000 + k))
     assert sorted(nc.remove_stale(keep=3)) == dirs[:2]
     assert sorted(tmp_path.iterdir()) == dirs[2:]
+
+
+def test_a_fresh_checkout_is_not_ready(tmp_path):
+    """A new checkout of the same sources has the same digest directory but new mtimes,
+    and numba then drops every cached kernel: the ready mark's stamps must change."""
+    pkg = _package(tmp_path)
+    before, digest = nc.source_stamps(pkg), nc.sources_digest(pkg)
+    assert [s[0] for s in before] == ["callee.py", "caller.py"]    # the numba files only
+    os.utime(pkg / "callee.py", (1e9, 1e9))                         # content unchanged
+    assert nc.sources_digest(pkg) == digest
+    assert nc.source_stamps(pkg) != before
