@@ -155,3 +155,14 @@ def test_common_refinement_of_nested_meshes():
         common_refinement(base, BoundaryMesh.polygon(SQUARE, n=2))
     with pytest.raises(ValueError, match="labels"):
         common_refinement(base, BoundaryMesh.polygon(sq, n=4, labels="C"))
+
+
+def test_a_copied_mesh_stays_read_only():
+    """A mesh is immutable: copy and deepcopy give the mesh itself, never writable arrays
+    (writable ones would be a second argument type for every numba kernel)."""
+    import copy
+
+    mesh = BoundaryMesh.polygon([(0, 0), (1, 0), (1, 1), (0, 1)], n=2, p=1)
+    scene = copy.deepcopy({"mesh": mesh, "state": np.zeros(3)})
+    assert scene["mesh"] is mesh and copy.copy(mesh) is mesh
+    assert not scene["mesh"].nodes.flags.writeable

@@ -97,6 +97,15 @@ class BoundaryMesh:
         if not self._checked:
             self._validate()
 
+    def __copy__(self):
+        return self
+
+    def __deepcopy__(self, memo):
+        """The mesh itself: it is immutable (frozen, read-only arrays).  A deep copy would
+        make its arrays writable, a new argument type for every numba kernel that takes
+        them (a scene copied by ``copy.deepcopy`` compiled the BEM kernels once more)."""
+        return self
+
     # ------------------------------------------------------------------ validation
     def _validate(self):
         """The checks of :func:`.validation.validate`; then every curve oriented
