@@ -39,10 +39,22 @@ def test_gmres_and_deflation_variants_agree():
                             preconditioner="near_field", coarse=None)
     b = solve_penalty_mixed(bem, run.eps, bh.gap, (0.0, -run.delta),
                             preconditioner="near_field", coarse=8)
-    c = solve_penalty_mixed(bem, run.eps, bh.gap, (0.0, -run.delta))    # multilevel
+    c = solve_penalty_mixed(bem, run.eps, bh.gap, (0.0, -run.delta),
+                            preconditioner="multilevel")
     assert a.converged and b.converged and c.converged
+    assert (a.preconditioner, c.preconditioner) == ("near_field", "multilevel")
     assert np.linalg.norm(a.U - b.U) <= 1e-6 * np.linalg.norm(a.U)
     assert np.linalg.norm(a.U - c.U) <= 1e-6 * np.linalg.norm(a.U)
+
+
+def test_auto_preconditioner_switches_at_the_measured_crossover(monkeypatch):
+    bem = _bem(64)
+    run = bh.HertzRun(64)
+    small = solve_penalty_mixed(bem, run.eps, bh.gap, (0.0, -run.delta))
+    monkeypatch.setattr(mf, "AUTO_NEAR_FIELD_MAX", 32)
+    large = solve_penalty_mixed(bem, run.eps, bh.gap, (0.0, -run.delta))
+    assert (small.preconditioner, large.preconditioner) == ("near_field", "multilevel")
+    assert np.linalg.norm(small.U - large.U) <= 1e-6 * np.linalg.norm(small.U)
 
 
 def test_non_convergence_is_reported_with_a_reason():
@@ -84,11 +96,13 @@ def test_bad_input_names_the_parameter():
 
 def _system_at_solution(n):
     """The mixed system of the Hertz run with N = n and the penalty Jacobian at its
-    solution (the contact set of the last Newton steps)."""
+    solution (the contact set of the last Newton steps); multilevel preconditioner."""
     run = bh.HertzRun(n)
     bem = _bem(n)
-    res = solve_penalty_mixed(bem, run.eps, bh.gap, (0.0, -run.delta), tol=run.tol)
-    sysm = mf._MixedSystem(bem, bh.gap, (0.0, -run.delta), None, "C", "D", None)
+    res = solve_penalty_mixed(bem, run.eps, bh.gap, (0.0, -run.delta), tol=run.tol,
+                              preconditioner="multilevel")
+    sysm = mf._MixedSystem(bem, bh.gap, (0.0, -run.delta), None, "C", "D", None,
+                           "multilevel")
     C = sysm.pen.jacobian(res.U, run.eps, sysm.n)
     return res, sysm, C[sysm.free][:, sysm.free]
 

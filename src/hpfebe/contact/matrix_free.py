@@ -58,7 +58,12 @@ __all__ = ["MixedPenaltyResult", "PenaltyP1", "near_field", "solve_penalty_mixed
 
 ARMIJO = 1e-4
 MIN_STEP = 2.0 ** -30
-PRECONDITIONERS = ("multilevel", "near_field")
+PRECONDITIONERS = ("auto", "multilevel", "near_field")
+# "auto": the near-field LU up to this many boundary elements, the multilevel one above.
+# Measured (Hertz scene, p = 1, CPU s of the whole solve, near_field / multilevel):
+# N = 64: 0.63 / 0.24 (one-off), 128: 0.40 / 0.68, 256: 1.47 / 1.59, 512: 9.89 / 4.67,
+# 1024: 51.5 / 11.0 - the LU's fill grows like N^1.5 and its GMRES iterations with N.
+AUTO_NEAR_FIELD_MAX = 256
 GAUSS2 = np.array([0.5 - 0.5 / np.sqrt(3.0), 0.5 + 0.5 / np.sqrt(3.0)])
 
 
@@ -247,6 +252,7 @@ class MixedPenaltyResult:
     times: dict = field(default_factory=dict)
     contact: PenaltyP1 | None = None
     n_active: int = 0
+    preconditioner: str = ""
 
 
 class _MixedSystem:
@@ -255,7 +261,7 @@ class _MixedSystem:
     products A0 Z (once), the mixed operator and each Newton step's preconditioner."""
 
     def __init__(self, bem, gap, dirichlet_displacement, load, contact_label,
-                 dirichlet_label, coarse, preconditioner="multilevel"):
+                 dirichlet_label, coarse, preconditioner="auto"):
         hm = getattr(bem, "hm", None)
         if hm is None:
             raise ValueError("bem: solve_penalty_mixed needs a LameBEM with "
@@ -291,6 +297,9 @@ class _MixedSystem:
         Wn = (hm.S.T @ near_field(hm.hmatrix("W")) @ hm.S).tocsr()
         self.Wff, self.Bf = Wn[self.free][:, self.free], Bn[:, self.free]
         self.t_near = time.process_time() - t0
+        if preconditioner == "auto":
+            small = len(mesh.elements) <= AUTO_NEAR_FIELD_MAX
+            preconditioner = "near_field" if small else "multilevel"
         self.kind = preconditioner
         if preconditioner == "multilevel":
             self._multilevel(bem, hm)
@@ -433,7 +442,7 @@ def solve_penalty_mixed(bem, eps: float, gap, dirichlet_displacement=(0.0, 0.0),
                         tol: float = 1e-8, max_iter: int = 50,
                         gmres_tol: float | None = None, restart: int = 200,
                         gmres_maxiter: int = 5, coarse: int | None = 16,
-                        preconditioner: str = "multilevel"
+                        preconditioner: str = "auto"
                         ) -> MixedPenaltyResult:
     """Penalty contact (3.45)-(3.46) of a compressed :class:`LameBEM` body (module doc).
 
@@ -448,8 +457,12 @@ def solve_penalty_mixed(bem, eps: float, gap, dirichlet_displacement=(0.0, 0.0),
     max_iter : Newton limit
     gmres_tol : relative residual of each Newton step's GMRES (default tol / 100)
     restart, gmres_maxiter : GMRES restart length and cycles
-    coarse : elements per coarse element of the deflation space (None: the near-field
-        LU alone)
+    coarse : elements per coarse element of the deflation space of the "near_field"
+        preconditioner (None: the near-field LU alone)
+    preconditioner : "multilevel" (block-triangular, :mod:`.mixed_precond`), "near_field"
+        (sparse LU of the near-field block matrix) or "auto": near_field up to
+        ``AUTO_NEAR_FIELD_MAX`` = 256 boundary elements, multilevel above (measured
+        crossover, see the constant); the choice is returned as ``preconditioner``
     """
     t_all = time.process_time()
     eps = real("eps (penalty parameter)", eps, positive=True)
@@ -514,4 +527,5 @@ def solve_penalty_mixed(bem, eps: float, gap, dirichlet_displacement=(0.0, 0.0),
                               eps=eps, iterations=info.iterations, info=info,
                               backward_errors=bes, gmres_iterations=gm_its, times=times,
                               contact=pen, n_active=int(pen.pieces(U)[2].__gt__(
-                                  pen.pieces(U)[1]).sum()))
+                                  pen.pieces(U)[1]).sum()),
+                              preconditioner=sysm.kind)
