@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import hashlib
 import os
+import re
 import shutil
 import sys
 from pathlib import Path
@@ -30,13 +31,34 @@ ENV = "NUMBA_CACHE_DIR"
 PREFIX = "hpfebe-"
 
 
-def sources_digest(package: Path = PACKAGE) -> str:
-    """A digest of the package's files that use numba (path and content), 16 hex digits."""
-    h = hashlib.blake2b(digest_size=8)
+#: the package's units above every kernel (module doc), relative to the package
+ABOVE_KERNELS = ("scenes", "suite", "__init__.py", "__main__.py", "cli.py", "jobclient.py",
+                 "jobserver.py")
+#: a jitted function defined in a file (decorator or call)
+_DEFINES_JIT = re.compile(rb"\b(njit|jit|vectorize|guvectorize|stencil|cfunc|overload|"
+                          rb"register_jitable)\b\s*\(|@(numba\.)?(njit|jit|vectorize|"
+                          rb"guvectorize|stencil|cfunc|overload|register_jitable)\b")
+
+
+def kernel_sources(package: Path = PACKAGE):
+    """(path, bytes) of the package's files that the kernels' machine code can depend on:
+    every file that mentions numba, but those of :data:`ABOVE_KERNELS` that define no
+    jitted function."""
     for path in sorted(package.rglob("*.py")):
         data = path.read_bytes()
-        if b"numba" in data:
-            h.update(str(path.relative_to(package)).encode() + b"\0" + data + b"\0")
+        if b"numba" not in data:
+            continue
+        if (path.relative_to(package).parts[0] in ABOVE_KERNELS
+                and not _DEFINES_JIT.search(data)):
+            continue
+        yield path, data
+
+
+def sources_digest(package: Path = PACKAGE) -> str:
+    """A digest of :func:`kernel_sources` (path and content), 16 hex digits."""
+    h = hashlib.blake2b(digest_size=8)
+    for path, data in kernel_sources(package):
+        h.update(str(path.relative_to(package)).encode() + b"\0" + data + b"\0")
     return h.hexdigest()
 
 
@@ -76,15 +98,14 @@ def remove_stale(keep: int = 3) -> list[Path]:
 
 
 def source_stamps(package: Path = PACKAGE) -> list:
-    """numba's freshness stamp of every file of the package that uses numba: (path,
+    """numba's freshness stamp of every file of :func:`kernel_sources`: (path,
     mtime, size).  numba keeps a cached kernel only while its file's stamp is the one it
     was compiled with, so a fresh checkout of the same sources (same digest directory,
     new mtimes) recompiles everything: the ready mark must know it."""
     out = []
-    for path in sorted(package.rglob("*.py")):
-        if b"numba" in path.read_bytes():
-            st = path.stat()
-            out.append([str(path.relative_to(package)), st.st_mtime, st.st_size])
+    for path, _ in kernel_sources(package):
+        st = path.stat()
+        out.append([str(path.relative_to(package)), st.st_mtime, st.st_size])
     return out
 
 

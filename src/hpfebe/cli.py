@@ -170,13 +170,14 @@ def read_config_files(files: list[Path]) -> list[tuple[Path, dict]]:
     top level that is not a mapping)."""
     import yaml
 
+    loader = getattr(yaml, "CSafeLoader", yaml.SafeLoader)     # libyaml: 10x faster
     out = []
     for f in files:
         if not f.is_file():
             raise CLIError(f"config file not found: {f}")
         try:
             with open(f, encoding="utf-8") as fh:
-                data = yaml.safe_load(fh) or {}
+                data = yaml.load(fh, Loader=loader) or {}
         except yaml.YAMLError as exc:
             raise CLIError(f"config file {f} is not valid YAML: {exc}") from None
         if not isinstance(data, dict):
@@ -186,10 +187,14 @@ def read_config_files(files: list[Path]) -> list[tuple[Path, dict]]:
     return out
 
 
-def load_config(files: list[Path]) -> dict:
+def load_config(files: list[Path], per_file=None) -> dict:
+    """The merged configuration of ``files`` (or of their ``per_file`` mappings, read;
+    copied: the run never changes what ``where_set`` reports)."""
+    import copy
+
     cfg: dict = {}
-    for _, data in read_config_files(files):
-        cfg = merge(cfg, data)
+    for _, data in per_file or read_config_files(files):
+        cfg = merge(cfg, copy.deepcopy(data))
     return cfg
 
 
@@ -351,7 +356,7 @@ def cmd_run(args) -> int:
         if args.quick:
             files.append(root / "config" / "quick.yaml")
     per_file = read_config_files(files)
-    config = load_config(files)
+    config = load_config(files, per_file)
     quick = check_top_level(per_file, config, [e.name for e in registry]) or args.quick
     if args.out:
         out = Path(args.out)

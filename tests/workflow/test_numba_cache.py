@@ -28,6 +28,21 @@ def test_an_edit_of_a_callee_changes_the_cache(tmp_path):
     assert nc.sources_digest(pkg) != before
 
 
+def test_the_workflow_layers_count_only_with_a_kernel_of_their_own(tmp_path):
+    """cli.py and suite/ sit above every kernel (tools/check_imports.py): editing them,
+    numba in their text, leaves the cache; a jitted function of their own counts."""
+    pkg = _package(tmp_path)
+    (pkg / "suite").mkdir()
+    (pkg / "cli.py").write_text("# times numba's JIT\n")
+    before = nc.sources_digest(pkg)
+    (pkg / "cli.py").write_text("# times numba's JIT, edited\n")
+    (pkg / "suite" / "warmup.py").write_text("# calls every numba kernel once\n")
+    assert nc.sources_digest(pkg) == before
+    assert [p.name for p, _ in nc.kernel_sources(pkg)] == ["callee.py", "caller.py"]
+    (pkg / "suite" / "warmup.py").write_text("import numba\nf = numba.njit(lambda x: x)\n")
+    assert nc.sources_digest(pkg) != before
+
+
 def test_root_kept_across_processes(tmp_path, monkeypatch):
     """A user's NUMBA_CACHE_DIR is the root; a child process of an hpfebe process (it
     inherits the digest directory) derives the same directory, not one nested in it."""

@@ -118,6 +118,22 @@ class Registry:
         raise KeyError(f"unknown artefact {name!r}; known artefacts: {known}")
 
 
+def _per_file(fn):
+    """Memoise ``fn(path, ...)`` on the file's (path, inode, mtime, size): a process that
+    discovers the registry again (the job server's forked jobs) parses only what changed."""
+    memo: dict = {}
+
+    def cached(path: Path, *args):
+        st = path.stat()
+        key = (str(path), st.st_ino, st.st_mtime_ns, st.st_size, *map(str, args))
+        if key not in memo:
+            memo[key] = fn(path, *args)
+        return memo[key]
+    cached.__doc__ = fn.__doc__
+    return cached
+
+
+@_per_file
 def _assignments(path: Path) -> dict[str, ast.expr]:
     """The module-level assignments ``NAME = value`` of a file (not executed)."""
     tree = ast.parse(path.read_text(encoding="utf-8"), filename=str(path))
@@ -221,26 +237,31 @@ def _module_files(name: str, directory: Path) -> tuple[Path, ...]:
     return ()
 
 
-def _imported_experiments(path: Path, directory: Path) -> set[str]:
-    """Names of the ``experiments/`` modules that ``path`` imports (at any level)."""
+@_per_file
+def _imported_names(path: Path, depth: int) -> frozenset[str]:
+    """Names of the ``experiments/`` modules that ``path`` (``depth`` folders below
+    experiments/) imports at any level, whether they exist or not."""
     tree = ast.parse(path.read_text(encoding="utf-8"), filename=str(path))
-    depth = len(path.relative_to(directory).parts) - 1    # 0: experiments/x.py
     names = set()
     for node in ast.walk(tree):
-        mods = []
         if isinstance(node, ast.ImportFrom):
             if node.level == 0 and node.module and node.module.startswith("experiments."):
-                mods.append(node.module.split(".")[1])
+                names.add(node.module.split(".")[1])
             elif node.level == 0 and node.module == "experiments":
-                mods += [a.name for a in node.names]
+                names.update(a.name for a in node.names)
             elif node.level == depth + 1:           # relative to experiments/ itself
-                mods += ([node.module.split(".")[0]] if node.module
-                         else [a.name for a in node.names])
+                names.update([node.module.split(".")[0]] if node.module
+                             else [a.name for a in node.names])
         elif isinstance(node, ast.Import):
-            mods += [a.name.split(".")[1] for a in node.names
-                     if a.name.startswith("experiments.")]
-        names.update(m for m in mods if _module_files(m, directory))
-    return names
+            names.update(a.name.split(".")[1] for a in node.names
+                         if a.name.startswith("experiments."))
+    return frozenset(names)
+
+
+def _imported_experiments(path: Path, directory: Path) -> set[str]:
+    """Names of the ``experiments/`` modules that ``path`` imports (at any level)."""
+    depth = len(path.relative_to(directory).parts) - 1    # 0: experiments/x.py
+    return {m for m in _imported_names(path, depth) if _module_files(m, directory)}
 
 
 def _sources(name: str, directory: Path) -> tuple[Path, ...]:
