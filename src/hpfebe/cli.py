@@ -458,19 +458,24 @@ def cmd_compile(args) -> int:
     a later call on the same host and the same checkout (numba's source stamps) finds it
     and returns at once (``--force`` runs the warm-up again; a kernel missing from the
     cache would still compile where it is called, as without the warm-up)."""
+    import hashlib
+
     from . import _numba_cache
+    from .suite import warmup
     from .suite.results import atomic_write
-    from .suite.warmup import compile_kernels
 
     cache = Path(os.environ[_numba_cache.ENV])
     ready, key = cache / "ready.json", _numba_cache.ready_key()
+    # and what the warm-up runs (outside the digest: it defines no kernel)
+    key["warmup"] = hashlib.blake2b(Path(warmup.__file__).read_bytes(),
+                                    digest_size=8).hexdigest()
     try:
         done = not args.force and json.loads(ready.read_text()) == key
     except (OSError, ValueError):
         done = False
     with JitTimer() as jit:
         t0 = time.perf_counter()
-        steps = {} if done else compile_kernels()
+        steps = {} if done else warmup.compile_kernels()
         wall = time.perf_counter() - t0
     if done:
         log.info("numba kernels ready: compiled before into %s (--force: again)", cache)

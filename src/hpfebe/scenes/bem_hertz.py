@@ -98,9 +98,11 @@ def hertz(F: float, e_star: float) -> tuple[float, float]:
     return float(a), float(2.0 * F / (np.pi * a))
 
 
-def solve(run: HertzRun, compression: str | None = "hmatrix") -> dict:
+def solve(run: HertzRun, compression: str | None = "hmatrix",
+          preconditioner: str = "auto") -> dict:
     """One run: the readings (a, p0, F, Hertz's, relative errors), CPU seconds, Newton
-    and GMRES iterations, backward errors; ``U`` and the nodal pressure profile."""
+    and GMRES iterations, backward errors, the preconditioner used (compressed: that of
+    :func:`solve_penalty_mixed`); ``U`` and the nodal pressure profile."""
     t0 = time.process_time()
     mesh = half_disk(run.n_elements)
     if compression is None:     # the dense path (:func:`solve_penalty`), small N
@@ -115,18 +117,20 @@ def solve(run: HertzRun, compression: str | None = "hmatrix") -> dict:
         U, converged, its = res.U + lift, res.converged, res.iterations
         pen = PenaltyP1(mesh, bem.V_space, np.flatnonzero(mesh.where("C")), gap)
         extra = dict(gmres_iterations=0, backward_error=np.nan, reason=res.reason,
-                     gmres_per_step=[], times={})
+                     gmres_per_step=[], times={}, preconditioner="dense LU")
     else:
         bem = LameBEM(mesh, E, NU, zero_force=False, compression=compression, tol=run.tol)
         t1 = time.process_time()
         for name in ("V", "K", "W"):
             bem.hm.hmatrix(name)
         assembly = time.process_time() - t1
-        res = solve_penalty_mixed(bem, run.eps, gap, (0.0, -run.delta), tol=run.tol)
+        res = solve_penalty_mixed(bem, run.eps, gap, (0.0, -run.delta), tol=run.tol,
+                                  preconditioner=preconditioner)
         U, converged, its, pen = res.U, res.converged, res.iterations, res.contact
         extra = dict(gmres_iterations=int(sum(res.gmres_iterations)),
                      backward_error=max(res.backward_errors), reason=res.reason,
                      gmres_per_step=list(res.gmres_iterations),
+                     preconditioner=res.preconditioner,
                      times=dict(assembly_s=assembly, **res.times))
     cpu = time.process_time() - t0
     xs = pen.half_width(U)

@@ -126,6 +126,10 @@ def _hmatrix(steps: dict) -> None:
     t = time.perf_counter()
     for pde, p in (("laplace", 1), ("laplace", 4), ("lame", 1), ("lame", 2)):
         bs.solve(bs.ScalingRun(pde, 16, p, "hmatrix"))   # figure_bem_scaling's cases
+    from ..scenes import bem_hertz as bh
+
+    for kind in ("near_field", "multilevel"):             # figure_bem_hertz ("auto")
+        bh.solve(bh.HertzRun(32), preconditioner=kind)
     steps["hmatrix"] = time.perf_counter() - t
 
 
