@@ -18,8 +18,8 @@ import time
 from pathlib import Path
 
 from .suite.published import published_file_for
-from .suite.watch import (ParentGone, Terminated, install_signal_handlers, terminated_cause,
-                          watch_parent_from_env)
+from .suite.watch import (ParentGone, Terminated, check_terminated, install_signal_handlers,
+                          terminated_cause, watch_parent_from_env)
 
 log = logging.getLogger("hpfebe")
 
@@ -428,6 +428,7 @@ def _run_job(job, module, config, per_file, files, out, quick, asked, root) -> N
         "argv": sys.argv[1:],
     }
     for r in results:
+        check_terminated()      # a signal whose exception a finalizer swallowed
         paths = res.write_result(r, out, section, run_info=run_info)
         log.info("wrote %s", ", ".join(str(p) for p in paths))
 

@@ -428,3 +428,24 @@ def test_a_signal_inside_a_compiled_kernel_is_still_a_termination():
         found = _terminated_cause(exc)
     assert isinstance(found, Terminated) and found.signum == 15
     assert _terminated_cause(ValueError("other")) is None
+
+
+def test_a_signal_swallowed_by_a_finalizer_still_ends_the_run(monkeypatch):
+    """SIGTERM's Terminated raised inside a __del__ is printed and dropped by Python (the
+    job then ran to its end and wrote its results: found by the job server's signal
+    test); check_terminated, called before every write, raises it again."""
+    import gc
+
+    from hpfebe.suite import watch
+
+    monkeypatch.setattr(watch, "RECEIVED", [])
+
+    class Finalized:
+        def __del__(self):
+            watch._on_signal(signal.SIGTERM, None)
+
+    Finalized()                  # the handler runs in __del__: "Exception ignored"
+    gc.collect()
+    with pytest.raises(watch.Terminated) as exc:
+        watch.check_terminated()
+    assert exc.value.signum == signal.SIGTERM

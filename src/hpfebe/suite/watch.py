@@ -58,11 +58,25 @@ class Terminated(BaseException):
         self.signum, self.why = signum, why
 
 
+#: the signals the handler received: the exception it raises can be swallowed (raised
+#: inside a finalizer, ``__del__``, Python prints "Exception ignored" and goes on), so
+#: :func:`check_terminated` raises it again before anything is written
+RECEIVED: list[int] = []
+
+
 def _on_signal(signum, frame):  # noqa: ARG001 - signal handler signature
     from .results import remove_temporaries
 
+    RECEIVED.append(signum)
     remove_temporaries()
     raise Terminated(signum)
+
+
+def check_terminated() -> None:
+    """Raise :class:`Terminated` if a SIGTERM/SIGHUP arrived, even one whose exception
+    was swallowed where it was raised (:data:`RECEIVED`)."""
+    if RECEIVED:
+        raise Terminated(RECEIVED[0])
 
 
 def install_signal_handlers() -> None:
