@@ -219,7 +219,8 @@ def _hertz(config: dict) -> list[ArtefactResult]:
     notes = ("Beyond the thesis (issue 27's showcase). " + bh.__doc__.split("\n\n")[1]
              .replace("\n", " ") + f" delta = {prm.delta:g}, kappa = {prm.kappa:g}, "
              f"tol = {prm.tol:g}, N = {list(prm.sizes)}; rates {fitted}. Larger N: python "
-             "tools/bem_hertz.py N (README, Compressed BEM: the N = 16384 showcase, run apart from the workflow).")
+             "tools/bem_hertz.py N (README, Compressed BEM: the N = 16384 showcase, run "
+             "apart from the workflow).")
     t = t.drop(columns=["reason"])
     return [ArtefactResult(name="figure_bem_hertz", table=t, figure=fig, keys=("N",),
                            claims=claims, notes=notes,

@@ -61,8 +61,8 @@ MIN_STEP = 2.0 ** -30
 PRECONDITIONERS = ("auto", "multilevel", "near_field")
 # "auto": the near-field LU up to this many boundary elements, the multilevel one above.
 # Measured (Hertz scene, p = 1, CPU s of the whole solve, near_field / multilevel):
-# N = 64: 0.63 / 0.24 (one-off), 128: 0.40 / 0.68, 256: 1.47 / 1.59, 512: 9.89 / 4.67,
-# 1024: 51.5 / 11.0 - the LU's fill grows like N^1.5 and its GMRES iterations with N.
+# N = 128: 0.40 / 0.68, 256: 1.47 / 1.59, 512: 9.89 / 4.67, 1024: 51.5 / 11.0 (the
+# near-field LU's GMRES iterations grow with N, the multilevel's stay nearly constant).
 AUTO_NEAR_FIELD_MAX = 256
 GAUSS2 = np.array([0.5 - 0.5 / np.sqrt(3.0), 0.5 + 0.5 / np.sqrt(3.0)])
 
