@@ -168,12 +168,17 @@ if workflow.is_main_process:
 # A cluster job's Snakemake removes the job's old outputs just before it runs the job
 # (snakemake.jobs.Job.prepare).  It may start, or reach that point, after the main
 # Snakemake was killed (a job from the queue; in a Snakemake group, `--groups`, one
-# nested Snakemake runs after another): there it stops first (the job fails, its old outputs and log untouched; the
-# profile's keep-incomplete keeps a failed job's outputs too).  The check is made at that
-# moment, not when this file is read: a job's Snakemake spends seconds between the two.
+# nested Snakemake runs after another): there it stops first (the job fails, its old
+# outputs and log untouched).  The check is made at that moment, not when this file is
+# read: a job's Snakemake spends seconds between the two.  The kill can still land just
+# after the check, so the old outputs are only set aside (hpfebe.suite.old_outputs): put
+# back when the job fails (the job, seeing its parent gone, stops), dropped once the
+# job's new outputs have passed Snakemake's checks.
 if not workflow.is_main_process:
+    from hpfebe.suite import old_outputs
     from hpfebe.suite.watch import parent_gone_from_env
     from snakemake.exceptions import WorkflowError
+    from snakemake.io import is_flagged
     from snakemake.jobs import Job as _Job
 
     async def _remove_existing_output(self, _remove=_Job.remove_existing_output):
@@ -182,9 +187,21 @@ if not workflow.is_main_process:
                 f"the Snakemake that submitted this job has ended: {self.rule.name} does "
                 "not run and its old outputs are kept (after an interrupted run: "
                 "snakemake --unlock, then rerun)")
-        await _remove(self)
+        old_outputs.set_aside(self.jobid, [f for f in self.output
+                                           if not is_flagged(f, "update")])
+        await _remove(self)                     # (the log, and nothing else is left)
+
+    async def _postprocess(self, *args, _post=_Job.postprocess, **kwargs):
+        error = kwargs.get("error", False)
+        try:           # (raises if the outputs are wrong: then called again with error)
+            await _post(self, *args, **kwargs)
+        finally:       # (after it: without keep-incomplete it removes a failed job's files)
+            if error:
+                old_outputs.restore(self.jobid)
+        old_outputs.drop(self.jobid)
 
     _Job.remove_existing_output = _remove_existing_output
+    _Job.postprocess = _postprocess
 
 
 _HEARTBEAT_STOP = threading.Event()
