@@ -8,6 +8,7 @@ import shutil
 import socket
 import subprocess
 import sys
+import time
 from pathlib import Path
 
 import pytest
@@ -290,18 +291,22 @@ def test_no_result_lands_after_the_parent_is_gone(tmp_path):
     assert sorted(p.name for p in out.iterdir()) == []
 
 
-def _job_snakemake(tree, parent_pid):
-    """The command a cluster job's nested Snakemake runs (SLURM: srun -> snakemake
-    --mode remote --target-jobs RULE:), for bem_laplace, the main Snakemake named by the
-    environment as ``parent_pid`` on this host."""
+def _job_command(parent_pid, *extra):
+    """The command and environment of a cluster job's nested Snakemake (SLURM: srun ->
+    snakemake --mode remote --target-jobs RULE:), for bem_laplace, the main Snakemake
+    named by the environment as ``parent_pid`` on this host."""
     env = dict(os.environ, HPFEBE_PARENT_PID=str(parent_pid),
                HPFEBE_PARENT_HOST=socket.gethostname())
-    return subprocess.run(
-        [sys.executable, "-m", "snakemake", "-s", str(ROOT / "Snakefile"), "--mode",
-         "remote", "--target-jobs", "bem_laplace:", "--allowed-rules", "bem_laplace",
-         "--cores", "1", "--force", "--keep-incomplete", "--nolock",
-         "--configfile", "config/quick.yaml"],
-        cwd=tree, env=env, capture_output=True, text=True, timeout=600)
+    return [sys.executable, "-m", "snakemake", "-s", str(ROOT / "Snakefile"), "--mode",
+            "remote", "--target-jobs", "bem_laplace:", "--allowed-rules", "bem_laplace",
+            "--cores", "1", "--force", "--nolock", "--configfile", "config/quick.yaml",
+            *extra], env
+
+
+def _job_snakemake(tree, parent_pid):
+    cmd, env = _job_command(parent_pid, "--keep-incomplete")
+    return subprocess.run(cmd, cwd=tree, env=env, capture_output=True, text=True,
+                          timeout=600)
 
 
 def test_job_after_the_kill_keeps_old_outputs(tree):
@@ -324,6 +329,37 @@ def test_job_after_the_kill_keeps_old_outputs(tree):
     r = _job_snakemake(tree, os.getpid())
     assert r.returncode == 0, r.stdout + r.stderr
     assert all(p.read_bytes() != data for p, data in old.items())
+
+
+def test_kill_after_the_check_puts_the_old_outputs_back(tree):
+    """The main Snakemake killed just after a job's Snakemake checked it (its old outputs
+    already set aside, hpfebe.suite.old_outputs): the job stops, fails, and its old
+    outputs come back unchanged, with their mtimes."""
+    (tree / "results" / "logs").mkdir(parents=True)
+    (tree / "results" / "logs" / "numba_cache.json").write_text("{}")
+    old = {tree / "results" / f"figure_bem_laplace.{ext}": f"old {ext}\n".encode()
+           for ext in ("csv", "json", "png")}
+    for path, data in old.items():
+        path.write_bytes(data)
+    mtimes = {p: p.stat().st_mtime_ns for p in old}
+    parent = subprocess.Popen([sys.executable, "-c", "import time; time.sleep(600)"])
+    cmd, env = _job_command(parent.pid)     # (without keep-incomplete: the harder case)
+    job = subprocess.Popen(cmd, cwd=tree, env=env, stdout=subprocess.PIPE,
+                           stderr=subprocess.STDOUT, text=True)
+    try:
+        t0 = time.time()
+        while all(p.exists() for p in old) and job.poll() is None and time.time() - t0 < 300:
+            time.sleep(0.001)
+        assert not any(p.exists() for p in old), "the outputs were not set aside"
+        parent.kill()
+        out, _ = job.communicate(timeout=300)
+    finally:
+        parent.kill()
+        job.kill()
+    assert job.returncode != 0, out
+    assert {p: p.read_bytes() for p in old} == old, out
+    assert {p: p.stat().st_mtime_ns for p in old} == mtimes
+    assert not list((tree / ".snakemake" / "hpfebe" / "old-outputs").rglob("*.*"))
 
 
 # --------------------------------------------------------------------------- registry
