@@ -4,6 +4,7 @@ history of touch 1 is carried into touch 2), and figure_4_1 ... figure_4_12 thro
 command line (quick configuration)."""
 
 import json
+import platform
 import subprocess
 import sys
 from pathlib import Path
@@ -195,3 +196,29 @@ def test_experiment_quick(tmp_path):
     assert "BE/BE converges under mesh refinement" in study["text"]
     assert study["holds"] is not None
     assert "BE/BE vs FE/FE on the same mesh" in study["evidence"]
+
+
+@pytest.mark.skipif(platform.machine() not in ("x86_64", "AMD64") or sys.platform == "darwin",
+                    reason="pypardiso is a dependency on x86_64 Linux/Windows only")
+def test_pardiso_is_the_sparse_lu_where_it_is_a_dependency():
+    """pyproject declares pypardiso on x86_64 (MKL wheels): its library is found and
+    used, not silently replaced by SuperLU."""
+    from hpfebe.contact.newton_matrix import FixedPatternLU
+    assert FixedPatternLU({}).backend == "pardiso"
+
+
+def test_pardiso_and_superlu_touches_agree(monkeypatch):
+    """One touch with each sparse LU of the fixed-pattern Newton systems: the same
+    records to the Newton tolerance (rtol 1e-8; the iteration counts may differ by
+    round-off)."""
+    from hpfebe.contact.newton_matrix import ENV_PARDISO
+    mat = J2Material(E, NU, 4.0, 450.0, 1.0)
+    out = {}
+    for env in ("1", "0"):
+        monkeypatch.setenv(ENV_PARDISO, env)
+        tr = _touch("FE", work_piece(WORK, 0.4, mat))
+        assert tr.converged, tr.reason
+        out[env] = tr
+    for ra, rb in zip(out["1"].records, out["0"].records, strict=True):
+        assert abs(ra.force - rb.force) <= 1e-6 * abs(out["0"].records[3].force)
+        assert abs(ra.dev_sigma_X - rb.dev_sigma_X) <= 1e-6 * rb.dev_sigma_X
