@@ -14,16 +14,22 @@ and closes them.  Plotting lives here and in the experiments, never in numerical
 
 from __future__ import annotations
 
+import io
 import math
 
+import matplotlib
 import numpy as np
+from matplotlib import colors as mcolors
+from matplotlib import image as mimage
+from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.collections import LineCollection
 from matplotlib.figure import Figure
 from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter
 from mpl_toolkits.axes_grid1 import make_axes_locatable
 
 __all__ = ["new_figure", "style_axes", "reference_slope", "slope_line",
-           "readable_log_ticks", "GRID", "mesh_sequence_figure", "deformed_field_figure"]
+           "readable_log_ticks", "GRID", "mesh_sequence_figure", "deformed_field_figure",
+           "png_bytes"]
 
 #: the grid of every convergence and work-precision plot: major and minor ticks, faint
 GRID = dict(which="both", alpha=0.3)
@@ -140,3 +146,45 @@ def deformed_field_figure(X, Y, u, mag: float, title: str):
                      fontsize="small")
     fig.suptitle(title + f" (grid deformed x{mag:g})", fontsize="small")
     return fig
+
+
+def png_bytes(fig: Figure, dpi: float = 120.0, pad_inches: float = 0.1) -> bytes:
+    """The PNG of ``fig`` as ``fig.savefig(..., dpi=dpi, bbox_inches="tight")`` writes it,
+    from one draw: savefig's tight bounding box costs a second (dry-run) draw, about
+    half of the time of writing a figure (measured: 14 figures of three quick jobs
+    3.03 s -> 1.90 s).  The figure is drawn once on an Agg canvas at ``dpi``; the
+    picture is the canvas cut to its tight bounding box padded by ``pad_inches``
+    (the pad outside the canvas in the face colour), the same size as savefig's;
+    the drawing differs from savefig's by its sub-pixel offset only (antialiased
+    edges).  Content outside the canvas (which savefig's tight box takes in): savefig
+    itself."""
+    old_dpi, old_canvas = fig.dpi, fig.canvas
+    canvas = FigureCanvasAgg(fig)
+    try:
+        fig.set_dpi(dpi)
+        canvas.draw()
+        tight = fig.get_tightbbox(canvas.get_renderer())           # inches
+        W, H = canvas.get_width_height()
+        inside = (tight.x0 >= 0 and tight.y0 >= 0 and tight.x1 * dpi <= W
+                  and tight.y1 * dpi <= H)
+        if inside:
+            box = tight.padded(pad_inches)
+            m = int(math.ceil(pad_inches * dpi)) + 1               # room for the pad
+            img = np.asarray(canvas.buffer_rgba())
+            face = np.round(255 * np.array(mcolors.to_rgba(fig.get_facecolor())))
+            big = np.empty((H + 2 * m, W + 2 * m, 4), dtype=img.dtype)
+            big[...] = face.astype(img.dtype)
+            big[m:m + H, m:m + W] = img
+            w, h = int(box.width * dpi), int(box.height * dpi)    # savefig's size
+            c0, r0 = int(round(box.x0 * dpi)) + m, int(round(H - box.y1 * dpi)) + m
+            buf = io.BytesIO()
+            mimage.imsave(buf, big[r0:r0 + h, c0:c0 + w], format="png", dpi=dpi,
+                          metadata={"Software": f"Matplotlib version"
+                                    f"{matplotlib.__version__}, https://matplotlib.org/"})
+            return buf.getvalue()
+    finally:
+        fig.set_dpi(old_dpi)
+        fig.set_canvas(old_canvas)
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png", dpi=dpi, bbox_inches="tight", pad_inches=pad_inches)
+    return buf.getvalue()

@@ -45,6 +45,7 @@ import numpy as np
 import pandas as pd
 
 from .claims import Claim, validate_claims
+from .figures import png_bytes as figure_png
 
 __all__ = [
     "ArtefactResult",
@@ -393,9 +394,7 @@ def write_result(result: ArtefactResult, out_dir: Path | str, config: dict | Non
 
     png = out / f"{result.name}.png"
     if result.figure is not None:
-        buf = io.BytesIO()
-        result.figure.savefig(buf, format="png", dpi=120, bbox_inches="tight")
-        png_bytes = buf.getvalue()
+        png_bytes = figure_png(result.figure, dpi=120)
         written.append(atomic_write(png, lambda f: f.write(png_bytes), mode="wb"))
         files["png"] = _file_record(png.name, png_bytes)
     elif png.exists():  # a stale figure from an earlier run would be mistaken as current
