@@ -449,3 +449,22 @@ def test_a_signal_swallowed_by_a_finalizer_still_ends_the_run(monkeypatch):
     with pytest.raises(watch.Terminated) as exc:
         watch.check_terminated()
     assert exc.value.signum == signal.SIGTERM
+
+
+def test_a_swallowed_signal_ends_a_sweep_at_its_next_case(monkeypatch):
+    """The sweeps' progress() checks for a signal before each case: a job whose SIGTERM
+    was swallowed stops there instead of computing to its end."""
+    from hpfebe.suite import watch
+    from hpfebe.suite.progressbar import progress
+
+    monkeypatch.setattr(watch, "RECEIVED", [])
+    done = []
+    with pytest.raises(watch.Terminated):
+        for k in progress(range(5), desc="cases"):
+            done.append(k)
+            if k == 1:
+                try:                      # library code with a broad except swallows it
+                    watch._on_signal(signal.SIGTERM, None)
+                except BaseException:     # noqa: BLE001
+                    pass
+    assert done == [0, 1]
