@@ -14,8 +14,8 @@ terms at *every* point is a superset of every Newton matrix of a load path.
 :class:`NewtonMatrix` writes A straight into P (index maps computed once; no scipy
 sparse sum, conversion or slicing per Newton step) and :class:`FixedPatternLU` factorises
 matrices on P: with PARDISO (MKL through ``pypardiso``, a dependency on x86_64 Linux and
-Windows where MKL has wheels; sequential MKL) the ordering and symbolic factorisation of P once and a numeric factorisation per
-matrix; without it, SuperLU (``scipy.sparse.linalg.splu``) of each matrix with the
+Windows where MKL has wheels; sequential MKL) the ordering and symbolic factorisation of
+P once and a numeric factorisation per matrix; without it, SuperLU (``scipy.sparse.linalg.splu``) of each matrix with the
 explicit zeros of P dropped (the matrices of the earlier code, to the order of their
 sums).  Measured on the stamping systems (8160 dofs, 1.4e5 nonzeros, one thread, loaded
 machine): SuperLU 28-31 ms, PARDISO's numeric factorisation 10 ms and solve 1.8 ms

@@ -150,8 +150,8 @@ def deformed_field_figure(X, Y, u, mag: float, title: str):
 
 def png_bytes(fig: Figure, dpi: float = 120.0, pad_inches: float = 0.1) -> bytes:
     """The PNG of ``fig`` as ``fig.savefig(..., dpi=dpi, bbox_inches="tight")`` writes it,
-    from one draw: savefig's tight bounding box costs a second (dry-run) draw, about
-    half of the time of writing a figure (measured: 14 figures of three quick jobs
+    from one draw: savefig's tight bounding box costs a second (dry-run) draw, about a
+    third of the time of writing a figure (measured: 14 figures of three quick jobs
     3.03 s -> 1.90 s).  The figure is drawn once on an Agg canvas at ``dpi``; the
     picture is the canvas cut to its tight bounding box padded by ``pad_inches``
     (the pad outside the canvas in the face colour), the same size as savefig's;
