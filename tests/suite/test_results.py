@@ -176,10 +176,11 @@ def test_json_is_strict_with_non_finite_meta(tmp_path):
     assert doc["meta"]["n"] == 3
 
 
-def test_progress_is_quiet_without_tty():
-    bar = progress(range(3))
-    assert list(bar) == [0, 1, 2]
-    assert bar.disable  # pytest captures stderr: not a TTY
+def test_progress_is_quiet_without_tty(capsys):
+    assert list(progress(range(3), desc="cases")) == [0, 1, 2]
+    assert capsys.readouterr().err == ""          # pytest captures stderr: not a TTY
+    assert list(progress(range(3), desc="cases", disable=False)) == [0, 1, 2]
+    assert "cases" in capsys.readouterr().err     # the bar, when asked for
 
 
 def test_suite_facade_is_light_and_complete():
