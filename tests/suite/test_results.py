@@ -149,7 +149,7 @@ def test_write_result_interrupted_mid_write(tmp_path, monkeypatch):
     def broken_png(figure, **kw):            # the PNG of the figure (suite.figures.png_bytes)
         raise OSError("simulated crash while writing the figure")
 
-    monkeypatch.setattr(res, "figure_png", broken_png)
+    monkeypatch.setattr("hpfebe.suite.figures.png_bytes", broken_png)
     with pytest.raises(OSError, match="simulated"):
         write_result(_result(name="figure_9_2", figure=fig), tmp_path)
     names = sorted(p.name for p in tmp_path.iterdir())

@@ -45,7 +45,6 @@ import numpy as np
 import pandas as pd
 
 from .claims import Claim, validate_claims
-from .figures import png_bytes as figure_png
 
 __all__ = [
     "ArtefactResult",
@@ -394,6 +393,8 @@ def write_result(result: ArtefactResult, out_dir: Path | str, config: dict | Non
 
     png = out / f"{result.name}.png"
     if result.figure is not None:
+        from .figures import png_bytes as figure_png     # matplotlib: only with a figure
+
         png_bytes = figure_png(result.figure, dpi=120)
         written.append(atomic_write(png, lambda f: f.write(png_bytes), mode="wb"))
         files["png"] = _file_record(png.name, png_bytes)
