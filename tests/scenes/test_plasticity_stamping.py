@@ -200,11 +200,14 @@ def test_experiment_quick(tmp_path):
 
 @pytest.mark.skipif(platform.machine() not in ("x86_64", "AMD64") or sys.platform == "darwin",
                     reason="pypardiso is a dependency on x86_64 Linux/Windows only")
-def test_pardiso_is_the_sparse_lu_where_it_is_a_dependency():
+def test_pardiso_is_the_sparse_lu_where_it_is_a_dependency(monkeypatch):
     """pyproject declares pypardiso on x86_64 (MKL wheels): its library is found and
-    used, not silently replaced by SuperLU."""
-    from hpfebe.contact.newton_matrix import FixedPatternLU
+    used, not silently replaced by SuperLU (unless HPFEBE_PARDISO=0 asks for that)."""
+    from hpfebe.contact.newton_matrix import ENV_PARDISO, FixedPatternLU
+    monkeypatch.delenv(ENV_PARDISO, raising=False)
     assert FixedPatternLU({}).backend == "pardiso"
+    monkeypatch.setenv(ENV_PARDISO, "0")
+    assert FixedPatternLU({}).backend == "superlu"
 
 
 def test_pardiso_and_superlu_touches_agree(monkeypatch):
