@@ -9,7 +9,10 @@ Example 2 (singular, (2.13)-(2.15)): h-version p = 1, FE h^-1 = 4..256, BE h^-1 
 p-version p = 1..7 on FE h^-1 = 4, BE h^-1 = 6 (Tables 2.3, 2.4; Figure 2.4).
 Figures 2.1 and 2.3: the computed solutions.  Beyond the thesis: error against wall time
 (figure_work_precision_ch2), each run timed ``timing_repeats`` times (the minimum is
-plotted).  The three are independent :data:`SCENES`.  Rates: log(e_prev/e) /
+plotted).  Two :data:`SCENES`: Example 1, and Example 2 with the work-precision figure,
+which times the runs of both examples' sweeps: a run computes each sweep once
+(:func:`sweep_memo`), so the work-precision figure repeats the cheap Example 1 sweep
+only when the scenes run as separate jobs.  Rates: log(e_prev/e) /
 log(h_prev/h), for the p-series log(e_prev/e) / log(p/p_prev).  The model problems, mesh
 sequences, sweeps and the choices where the thesis is silent
 (``interface.CONVERGENCE_CHOICES``): :mod:`hpfebe.scenes.interface`; the claims' verdicts:
@@ -18,6 +21,7 @@ sequences, sweeps and the choices where the thesis is silent
 
 from __future__ import annotations
 
+import functools
 import time
 from dataclasses import replace
 
@@ -32,10 +36,11 @@ from hpfebe.suite import (ArtefactResult, Claim, from_config_sections, joint_cla
 
 ARTEFACTS = ("table_2_1", "table_2_2", "table_2_3", "table_2_4", "figure_2_1", "figure_2_2",
              "figure_2_3", "figure_2_4", "figure_work_precision_ch2")
-#: independent computations: Example 1, Example 2, and the timed runs of both
+#: independent computations: Example 1, and Example 2 with the timed runs of both (the
+#: work-precision figure shares Example 2's sweep, the expensive one)
 SCENES = {"smooth": ("table_2_1", "table_2_2", "figure_2_1", "figure_2_2"),
-          "singular": ("table_2_3", "table_2_4", "figure_2_3", "figure_2_4"),
-          "work_precision": ("figure_work_precision_ch2",)}
+          "singular": ("table_2_3", "table_2_4", "figure_2_3", "figure_2_4",
+                       "figure_work_precision_ch2")}
 
 KEYS = ("series", "h_inv", "p")
 TOL = {"l2_error": ("factor", 2.0), "h1_error": ("factor", 2.0),
@@ -59,15 +64,21 @@ def _ratio(table, name, *cols) -> pd.Series:
     return pd.concat([published_ratio(table, _published(name), KEYS, c) for c in cols])
 
 
-def example_sweeps(prm: Params, example: str, companions: bool = True):
-    """(h-sweep, p-sweep, seconds) of ``example``; ``companions`` adds the BE trace
-    energy error and the interpolation error of the exact u (the tables' extra columns)."""
+def example_sweeps(prm: Params, example: str):
+    """(h-sweep, p-sweep, seconds) of ``example``, with the companion columns (the BE
+    trace energy error, the interpolation error of the exact u) of the tables."""
     def sweeps():
         return [pd.DataFrame(interface.sweep_rows(
-            example, series, cases, [prm.lambda_nit], prm.alpha, prm.h_def, "", companions,
+            example, series, cases, [prm.lambda_nit], prm.alpha, prm.h_def, "", True,
             progress)) for series, cases in interface.sweep_cases(prm, example).items()]
     (h, p), seconds = timed(sweeps)
     return h, p, seconds
+
+
+def sweep_memo(prm: Params):
+    """example -> :func:`example_sweeps` of ``prm``, each computed once: the tables of an
+    example and the work-precision figure use the same runs."""
+    return functools.cache(lambda example: example_sweeps(prm, example))
 
 
 def _meta(prm: Params, jit_s: float, **seconds) -> dict:
@@ -208,9 +219,10 @@ def _convergence_figure(h, pv, title, slopes):
 
 
 # ----------------------------------------------------------------------------- scenes
-def smooth_scene(prm: Params, jit_s: float) -> list[ArtefactResult]:
-    """Example 1: Tables 2.1 (BE part), 2.2 (FE part), Figures 2.1, 2.2."""
-    sm_h, sm_p, t = example_sweeps(prm, "smooth")
+def smooth_scene(prm: Params, jit_s: float, sweeps) -> list[ArtefactResult]:
+    """Example 1: Tables 2.1 (BE part), 2.2 (FE part), Figures 2.1, 2.2 (``sweeps``:
+    :func:`sweep_memo`)."""
+    sm_h, sm_p, t = sweeps("smooth")
     meta, (pf, pb) = _meta(prm, jit_s, smooth_s=t), prm.smooth.p_mesh
     out = []
     for name, part, h_col in (("table_2_1", "BE", "be_h_inv"), ("table_2_2", "FE", "fe_h_inv")):
@@ -235,9 +247,10 @@ def smooth_scene(prm: Params, jit_s: float) -> list[ArtefactResult]:
                             f"{pb} (24 elements), p1 = p2.", meta=meta)]
 
 
-def singular_scene(prm: Params, jit_s: float) -> list[ArtefactResult]:
-    """Example 2: Tables 2.3 (BE part), 2.4 (FE part), Figures 2.3, 2.4."""
-    sg_h, sg_p, t = example_sweeps(prm, "singular")
+def singular_scene(prm: Params, jit_s: float, sweeps) -> list[ArtefactResult]:
+    """Example 2: Tables 2.3 (BE part), 2.4 (FE part), Figures 2.3, 2.4, and the
+    work-precision figure of both examples (:func:`work_precision`)."""
+    sg_h, sg_p, t = sweeps("singular")
     meta, (qf, qb) = _meta(prm, jit_s, singular_s=t), prm.singular.p_mesh
     sg_all = pd.concat([sg_h, sg_p], ignore_index=True)
     t23 = pd.DataFrame(interface.part_table(sg_all, "be", "be_h_inv"))
@@ -261,14 +274,15 @@ def singular_scene(prm: Params, jit_s: float) -> list[ArtefactResult]:
             _table("table_2_4", t24, "FE", c24, TOL_SINGULAR, meta, notes),
             solution_figure(prm, "singular", meta),
             ArtefactResult(name="figure_2_4", table=sg_all, figure=fig,
-                           claims=[c23[2], c24[1], hyp], notes=_notes(prm), meta=meta)]
+                           claims=[c23[2], c24[1], hyp], notes=_notes(prm), meta=meta),
+            work_precision(prm, jit_s, sweeps)]
 
 
-def work_precision(prm: Params, jit_s: float) -> list[ArtefactResult]:
-    """Beyond the thesis: FE + BE energy error against wall time (assembly + solve)."""
+def work_precision(prm: Params, jit_s: float, sweeps) -> ArtefactResult:
+    """Beyond the thesis: FE + BE energy error against wall time (assembly + solve) of
+    the runs of ``sweeps`` (:func:`sweep_memo`), each timed ``timing_repeats`` times."""
     t0 = time.perf_counter()
-    rows = [r for example in interface.EXAMPLES
-            for sweep in example_sweeps(prm, example, companions=False)[:2]
+    rows = [r for example in interface.EXAMPLES for sweep in sweeps(example)[:2]
             for r in sweep.to_dict("records")]
     wp = pd.DataFrame(interface.work_precision_rows(prm, rows))
     fig, axs = new_figure((10.0, 4.5), 1, 2)
@@ -281,7 +295,7 @@ def work_precision(prm: Params, jit_s: float) -> list[ArtefactResult]:
         style_axes(ax, f"wall time (assembly + solve) [s], min of {prm.timing_repeats}",
                    "FE + BE energy error", name, title_size=9, legend=dict(fontsize=7))
     spread = float((wp.wall_time_max_s / wp.wall_time_s).max())
-    return [ArtefactResult(
+    return ArtefactResult(
         name="figure_work_precision_ch2",
         table=wp[["problem", "series", "p", "fe_h_inv", "be_h_inv", "dof", "fe_l2", "fe_h1",
                   "be_l2", "be_h1", "assembly_s", "solve_s", "wall_time_s",
@@ -298,11 +312,10 @@ def work_precision(prm: Params, jit_s: float) -> list[ArtefactResult]:
               f"{jit_s:.1f} s). Error = FE + BE energy error. The target error is 3 x the "
               "smallest error of the p-version.",
         meta=dict(_meta(prm, jit_s, total_s=time.perf_counter() - t0),
-                  timing_repeats=prm.timing_repeats, timing_spread_max=round(spread, 3)))]
+                  timing_repeats=prm.timing_repeats, timing_spread_max=round(spread, 3)))
 
 
-SCENE_RUNS = {"smooth": smooth_scene, "singular": singular_scene,
-              "work_precision": work_precision}
+SCENE_RUNS = {"smooth": smooth_scene, "singular": singular_scene}
 
 
 def run(config: dict, quick: bool = False, scenes=None) -> list[ArtefactResult]:
@@ -312,5 +325,5 @@ def run(config: dict, quick: bool = False, scenes=None) -> list[ArtefactResult]:
                                smooth=interface.SmoothParams,
                                singular=interface.SingularParams)
     names = select_scenes(SCENES, scenes, "ch2_convergence")
-    jit_s = interface.warm_up(prm)
-    return [r for name in names for r in SCENE_RUNS[name](prm, jit_s)]
+    jit_s, sweeps = interface.warm_up(prm), sweep_memo(prm)
+    return [r for name in names for r in SCENE_RUNS[name](prm, jit_s, sweeps)]
