@@ -282,6 +282,9 @@ class TwoBodyContact:
         self.F = None if F is None else pointwise("F", F, self.points, allow_negative=False)
         self.law_name = "tresca" if F is not None else "coulomb"
         self.exact = self._exact_quadrature(quadrature, slave_boundary)
+        # the body tangents' block diagonal of the last iterate, and its index arrays
+        self._blocks_last = None
+        self._block_pattern = _BlockDiagonal()
 
     @staticmethod
     def _two_pass(two_pass, master, quadrature) -> bool:
@@ -432,7 +435,7 @@ class TwoBodyContact:
         """The block diagonal of the body tangents (4.27)/(4.33): dense without FE body.
         Built once while the bodies return the same tangent objects (linear bodies: their
         stiffness, at every Newton iterate), rebuilt when a tangent changes (plastic)."""
-        last = getattr(self, "_blocks_last", None)
+        last = self._blocks_last
         if last is not None and last[0] is Ks and last[1] is Km:
             return last[2]
         if Km.shape[0] == 0:
@@ -440,8 +443,6 @@ class TwoBodyContact:
         elif self.dense:
             out = sla.block_diag(Ks, Km)
         else:
-            if getattr(self, "_block_pattern", None) is None:
-                self._block_pattern = _BlockDiagonal()
             out = self._block_pattern(sp.csr_matrix(Ks), sp.csr_matrix(Km))
         self._blocks_last = (Ks, Km, out)
         return out
