@@ -18,12 +18,11 @@ import numpy as np
 
 from hpfebe.bodies.plastic_be import PlasticBEBody
 from hpfebe.constitutive.j2 import J2Material
-from hpfebe.contact import ContactSettings, TwoBodyContact
-from hpfebe.contact.loading import LoadSteps
 from hpfebe.scenes.materials import E, H, NU, SIGMA_Y
 from hpfebe.scenes.stamping import be_work_piece, stamp_body
 
-from .test_ch4_newton import _stepper   # one Newton step, the cached state moved away
+# one Newton step (the cached state moved away) at the bonded predictor's iterate
+from .test_ch4_newton import _stepper, predictor_iterate
 
 H_BEBE = 0.4
 WORK = (-2.0, 2.0, -3.0, -1.0)
@@ -36,15 +35,7 @@ def test_bench_newton_step_bebe(benchmark):
     bonded predictor's iterate (a plastic zone under the stamp)."""
     be = be_work_piece(WORK, H_BEBE, J2Material(E, NU, SIGMA_Y, H, 1.0), "crossed")
     stamp = stamp_body("BE", STAMP, H_BEBE, E, NU, p=1)
-    pr = TwoBodyContact(stamp, PlasticBEBody(be), "bottom", "top", eps_n=1 / (10 * E),
-                        eps_t=1 / (5 * E), mu_f=0.2)
-    fixed, is_y = pr.stamp_dofs()
-    settings = ContactSettings(rtol=1e-8, max_iter=40, line_search=True, predictor=True,
-                               lu_ordering="MMD_AT_PLUS_A")
-    steps = LoadSteps(pr, None, fixed, np.where(is_y, LIFT, 0.0), settings)
-    steps.problem(1.0)
-    x = steps.start(np.zeros(pr.ndofs), 1.0)
-    x = steps.bonded_predictor(steps.evaluate(x))
+    pr, steps, x = predictor_iterate(stamp, PlasticBEBody(be), LIFT)
     plastic = be.implicit_response(x[pr.offset:])[1].plastic
     assert plastic.mean() > 0.1
     dx = steps.step(steps.evaluate(x))

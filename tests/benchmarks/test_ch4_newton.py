@@ -45,6 +45,21 @@ def _stepper(problem, x):
     return step
 
 
+def predictor_iterate(stamp, work, lift: float = LIFT):
+    """(problem, steps, x): the stamp on the plastic ``work`` body (frictional penalty
+    contact of the stamping runs), the load steps of a first increment ``lift`` and its
+    bonded predictor's iterate x."""
+    pr = TwoBodyContact(stamp, work, "bottom", "top", eps_n=1 / (10 * E),
+                        eps_t=1 / (5 * E), mu_f=0.2)
+    fixed, is_y = pr.stamp_dofs()
+    settings = ContactSettings(rtol=1e-8, max_iter=40, line_search=True, predictor=True,
+                               lu_ordering="MMD_AT_PLUS_A")
+    steps = LoadSteps(pr, None, fixed, np.where(is_y, lift, 0.0), settings)
+    steps.problem(1.0)
+    x = steps.start(np.zeros(pr.ndofs), 1.0)
+    return pr, steps, steps.bonded_predictor(steps.evaluate(x))
+
+
 def test_bench_newton_step_plastic_body(benchmark):
     """The work piece alone: bottom lifted by LIFT, the top centre third held (plastic
     under it)."""
@@ -69,14 +84,6 @@ def test_bench_newton_step_stamping(benchmark, stamp_kind):
     plastic)."""
     fe = _work()
     stamp = stamp_body(stamp_kind, (0.2, 1.2, -1.0, 1.0), H_FINE, E, NU)
-    pr = TwoBodyContact(stamp, PlasticFEBody(fe), "bottom", "top", eps_n=1 / (10 * E),
-                        eps_t=1 / (5 * E), mu_f=0.2)
-    fixed, is_y = pr.stamp_dofs()
-    settings = ContactSettings(rtol=1e-8, max_iter=40, line_search=True, predictor=True,
-                               lu_ordering="MMD_AT_PLUS_A")
-    steps = LoadSteps(pr, None, fixed, np.where(is_y, LIFT, 0.0), settings)
-    steps.problem(1.0)
-    x = steps.start(np.zeros(pr.ndofs), 1.0)
-    x = steps.bonded_predictor(steps.evaluate(x))
+    pr, steps, x = predictor_iterate(stamp, PlasticFEBody(fe))
     assert fe.state_at(x[pr.offset:])[1].plastic.mean() > 0.1
     benchmark(_stepper(steps, x))
