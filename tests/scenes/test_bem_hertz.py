@@ -21,6 +21,8 @@ def test_hertz_errors_decrease_with_h():
     # symmetric contact set around x = 0, pressure positive only inside it
     x, p = fine["profile"]
     assert np.all(np.abs(x[p > 0]) <= fine["a"] * (1 + 1e-12))
+    # one pressure per node of the contact boundary (nodes shared by two elements once)
+    assert np.all(np.diff(x) > 0)
 
 
 def test_mesh_labels_and_gap():

@@ -141,8 +141,10 @@ def solve(run: HertzRun, compression: str | None = "hmatrix",
     w = pen.penetration(U)
     p0 = float(np.maximum(w, 0.0).max()) / run.eps
     aH, p0H = hertz(F, run.e_star)
-    x_nodes = np.concatenate([pen.a[:, 0], pen.b[:, 0]])
-    p_nodes = np.maximum(np.concatenate([w[:, 0], w[:, 1]]), 0.0) / run.eps
+    # each node ends one contact element and starts the next: its pressure once
+    x_nodes, first = np.unique(np.concatenate([pen.a[:, 0], pen.b[:, 0]]),
+                               return_index=True)
+    p_nodes = np.maximum(np.concatenate([w[:, 0], w[:, 1]])[first], 0.0) / run.eps
     return dict(N=run.n_elements, h=run.h, delta=run.delta, eps=run.eps, a=a, p0=p0, F=F,
                 a_hertz=aH, p0_hertz=p0H, err_a=abs(a - aH) / aH,
                 err_p0=abs(p0 - p0H) / p0H, cpu_s=cpu, newton=its, converged=converged,
