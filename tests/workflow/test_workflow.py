@@ -3,6 +3,7 @@ registry.  No test reads or writes the working tree's results/, report/ or .snak
 the runs use a scratch directory whose experiments/, config/, src/, profiles/ and
 report/published/ are links to the checkout's."""
 
+import json
 import os
 import shutil
 import socket
@@ -447,3 +448,29 @@ def test_registry_packages(tmp_path):
     (tmp_path / "ch1_b.py").write_text('ARTEFACTS = ("figure_1_1",)\n')
     with pytest.raises(ValueError, match="claimed by both"):
         registry.discover(tmp_path)
+
+
+def _priorities(r) -> dict[str, int]:
+    """rule -> priority of the jobs a dry run plans."""
+    assert r.returncode == 0, r.stdout + r.stderr
+    out = {}
+    for block in r.stdout.split("\nrule ")[1:]:
+        name = block.split(":", 1)[0].strip()
+        for line in block.splitlines():
+            if line.strip().startswith("priority:"):
+                out[name] = int(line.split(":", 1)[1])
+    return out
+
+
+def test_longest_first_from_the_last_run_of_the_same_configuration(tree):
+    """The priorities (longest job first) take a job's time from its last result only
+    if that run had this configuration: a quick run's times do not order a full run."""
+    (tree / "results").mkdir()
+    fake = {"provenance": {"run": {"quick": True, "module_wall_time_s": 1.0e6}}}
+    (tree / "results" / "figure_bem_laplace.json").write_text(json.dumps(fake))
+    full = _priorities(snakemake("-n", "--forceall", cwd=tree))
+    quick = _priorities(snakemake("-n", "--forceall", "--configfile", "config/quick.yaml",
+                                  cwd=tree))
+    top = max(v for k, v in quick.items() if k != "numba_cache")
+    assert quick["bem_laplace"] == top                 # its quick result: the longest
+    assert full["bem_laplace"] < max(v for k, v in full.items() if k != "numba_cache")
