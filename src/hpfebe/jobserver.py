@@ -43,8 +43,9 @@ import traceback
 
 from .jobclient import read_line  # noqa: F401  (the protocol: one module defines both)
 
-#: environment variables read at import time: a client must agree on all of them
-IMPORT_TIME_PREFIXES = ("PYTHON", "NUMBA_", "OMP_", "OPENBLAS_", "MKL_")
+#: environment variables read at import time (MALLOC_: at the process start, by glibc's
+#: allocator): a client must agree on all of them
+IMPORT_TIME_PREFIXES = ("PYTHON", "NUMBA_", "OMP_", "OPENBLAS_", "MKL_", "MALLOC_")
 MAX_REQUEST = 1 << 22
 
 
