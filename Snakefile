@@ -326,8 +326,8 @@ def numba_input(*exps):
 # the job's wall time measured by its last run (results/<artefact>.json) if that run had
 # this run's configuration (quick or full: a quick run's times misordered the next full
 # run, 95.4 s against 90.4 s), else the figure recorded in config/job_times.yaml
-# (tools/job_times.py writes it from a full run).  The recorded figures also size a cluster job (runtime, mem_mb): the SLURM
-# profile takes them from here.
+# (tools/job_times.py writes it from a full run).  The recorded figures also size a
+# cluster job (runtime, mem_mb): the SLURM profile takes them from here.
 JOB_TIMES_FILE = Path(workflow.basedir) / "config" / "job_times.yaml"
 
 

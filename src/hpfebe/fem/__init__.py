@@ -1,6 +1,7 @@
 """Finite element parts (scikit-fem based): labelled meshes, Poisson Q_p, linear elasticity,
-the J2 plastic body with quadrature-point state (the J2 law: :mod:`hpfebe.constitutive.j2`), Newton potentials of plastic cells.  Importing it makes scikit-fem find the edges of a mesh
-by integer keys (:mod:`.skfem_entities`: the same arrays, 3-9x faster)."""
+the J2 plastic body with quadrature-point state (the J2 law: :mod:`hpfebe.constitutive.j2`),
+Newton potentials of plastic cells.  Importing it makes scikit-fem find the edges of a
+mesh by integer keys (:mod:`.skfem_entities`: the same arrays, 3-9x faster)."""
 
 from . import skfem_entities
 from .meshes import (Concentration, FEDomain, block_grid, cell_diameter, distance_to_set,
