@@ -282,9 +282,8 @@ class TwoBodyContact:
         self.F = None if F is None else pointwise("F", F, self.points, allow_negative=False)
         self.law_name = "tresca" if F is not None else "coulomb"
         self.exact = self._exact_quadrature(quadrature, slave_boundary)
-        # the body tangents' block diagonal of the last iterate, and its index arrays
-        self._blocks_last = None
-        self._block_pattern = _BlockDiagonal()
+        # the last block diagonal of the body tangents and its index arrays (_blocks)
+        self._blocks_last, self._block_pattern = None, _BlockDiagonal()
 
     @staticmethod
     def _two_pass(two_pass, master, quadrature) -> bool:
