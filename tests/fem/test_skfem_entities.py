@@ -25,6 +25,16 @@ def test_installed_on_import():
     assert se.install()
 
 
+def test_install_leaves_an_unknown_scikit_fem_alone(monkeypatch):
+    """A scikit-fem whose build_entities is missing or has another signature is left as
+    it is (install returns False, nothing replaced)."""
+    monkeypatch.setattr(se, "_static", lambda name: None)
+    monkeypatch.setattr(se, "_ORIGINAL", lambda t, indices: None)
+    assert se.install() is False
+    monkeypatch.setattr(se, "_ORIGINAL", None)
+    assert se.install() is False
+
+
 @pytest.mark.parametrize("mesh", _meshes(), ids=lambda m: f"{type(m).__name__}{m.t.shape}")
 @pytest.mark.parametrize("sort", [True, False])
 def test_same_arrays_as_scikit_fem(mesh, sort):

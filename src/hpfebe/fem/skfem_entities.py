@@ -24,7 +24,15 @@ from skfem.mesh.mesh import Mesh
 
 __all__ = ["build_entities", "install"]
 
-_ORIGINAL = Mesh.__dict__["build_entities"].__func__
+def _static(name: str):
+    """Mesh's attribute ``name`` as a plain function (unwrapped from its staticmethod),
+    or None if it is none: a later scikit-fem without it leaves hpfebe importable."""
+    f = inspect.getattr_static(Mesh, name, None)
+    f = getattr(f, "__func__", f) if isinstance(f, staticmethod) else None
+    return f if callable(f) else None
+
+
+_ORIGINAL = _static("build_entities")
 
 
 def build_entities(t, indices, sort=True):
@@ -48,9 +56,10 @@ def build_entities(t, indices, sort=True):
 def install() -> bool:
     """Use :func:`build_entities` in scikit-fem's meshes; False (nothing changed) if
     scikit-fem's method does not have the signature it replaces."""
-    if Mesh.__dict__["build_entities"].__func__ is build_entities:
+    if _static("build_entities") is build_entities:
         return True
-    if list(inspect.signature(_ORIGINAL).parameters) != ["t", "indices", "sort"]:
+    if _ORIGINAL is None or \
+            list(inspect.signature(_ORIGINAL).parameters) != ["t", "indices", "sort"]:
         return False
     Mesh.build_entities = staticmethod(build_entities)
     return True
