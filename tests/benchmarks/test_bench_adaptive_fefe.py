@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from hpfebe.adaptivity import hooke_stress, fe_indicators, two_body_indicators
-from hpfebe.contact.loading import WoodburySolver
+from hpfebe.contact.woodbury import WoodburySolver
 from hpfebe.fem import ElasticBody, refine_labelled
 from hpfebe.scenes import adaptive_fefe as scene
 

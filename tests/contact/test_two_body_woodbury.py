@@ -1,6 +1,7 @@
 """The Woodbury Newton solver of two linear bodies in contact
-(hpfebe.contact.loading.WoodburySolver, ``TwoBodyContact.solve(linear_solver="woodbury")``):
-the same Newton solution as a sparse LU of every Newton matrix, up to round-off.
+(hpfebe.contact.woodbury.WoodburySolver, ``TwoBodyContact.solve(linear_solver="woodbury")``):
+the same Newton solution as a sparse LU of every Newton matrix, up to round-off, with
+each body factorised by PARDISO or by SuperLU.
 
 Scene: the Figure 4.13 setup (slave [-1/2, 1/2] x [0, 2], top fixed; master [-2, 2] x
 [-2, 0], bottom lifted by 5e-4; Coulomb mu_f = 0.1) on the initial meshes once refined.
@@ -12,12 +13,17 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from hpfebe.contact.loading import WoodburySolver
+from hpfebe.solvers import SingularStep
+
 from hpfebe.contact import ContactSettings, TwoBodyContact
+from hpfebe.contact.newton_matrix import _pardiso_solver
+from hpfebe.contact.woodbury import SuperLUBody, WoodburySolver
 from hpfebe.fem import refine_labelled
 from hpfebe.fem.elasticity import ElasticBody, rectangle_mesh
 
 E, NU = 266926.0, 0.29
+BACKENDS = ["superlu", pytest.param("pardiso", marks=pytest.mark.skipif(
+    _pardiso_solver() is None, reason="pypardiso not installed"))]
 
 
 def _problem(refine=1):
@@ -47,14 +53,17 @@ def test_woodbury_gives_the_lu_solution(predictor):
     np.testing.assert_allclose(b.p_n, a.p_n, rtol=1e-9, atol=1e-9 * a.p_n.max())
 
 
-def test_schur_complement_inverse_and_solve_match_dense_algebra():
+@pytest.mark.parametrize("backend", BACKENDS)
+def test_schur_complement_inverse_and_solve_match_dense_algebra(backend):
     pr, fixed, _ = _problem(refine=0)
     free = np.setdiff1d(np.arange(pr.ndofs), fixed)
-    wb = WoodburySolver(pr.K, free, pr.offset, pr.Gn, pr.Gt)
+    wb = WoodburySolver(pr.K, free, pr.offset, pr.Gn, pr.Gt, backend=backend)
+    assert [f.backend for _, _, f in wb.blocks] == [backend, backend]
     Kd = pr.K.toarray()[np.ix_(free, free)]
     Kinv = np.linalg.inv(Kd)
     c = wb.rows
-    assert wb.from_factors == [True, True]      # the Schur complements of the factors
+    # SuperLU: the Schur complements of the factors; PARDISO: partial solves
+    assert wb.from_factors == [backend == "superlu"] * 2
     np.testing.assert_allclose(wb._columns(c), Kinv[np.ix_(c, c)], rtol=1e-9,
                                atol=1e-9 * np.abs(Kinv).max())
     # a Newton matrix with stick (W_n, W_t) and slip (W_n, W_tn) points
@@ -78,15 +87,25 @@ def test_bad_linear_solver_is_rejected():
         pr.solve(None, fixed, vals, settings=ContactSettings(linear_solver="cholesky"))
 
 
-def test_floating_body_is_reported_as_singular():
+@pytest.mark.parametrize("backend", BACKENDS)
+def test_floating_body_is_reported_as_singular(backend, monkeypatch):
     """A master held by the contact only (no Dirichlet conditions, pushed up by a
     traction): its K is singular, the Woodbury solve fails with a reason."""
+    monkeypatch.setenv("HPFEBE_PARDISO", "1" if backend == "pardiso" else "0")
     pr, fixed, vals = _problem(refine=0)
     keep = fixed < pr.offset           # only the slave's top fixed: the master floats
     f = pr.traction_load("master", "bottom", (0.0, 100.0))
     res = pr.solve(f, fixed[keep], vals[keep], settings=ContactSettings(linear_solver="woodbury"))
     assert not res.converged
     assert "singular" in res.reason
+    if backend == "superlu":
+        return        # SuperLU factorises the singular K: the step's residual check fails
+    # PARDISO's Cholesky finds a nonpositive pivot: the solver says so itself
+    free = np.setdiff1d(np.arange(pr.ndofs), fixed[keep])
+    wb = WoodburySolver(pr.K, free, pr.offset, pr.Gn, pr.Gt, backend=backend)
+    with pytest.raises(SingularStep, match="singular body stiffness"):
+        wb.solve(np.zeros(pr.points.shape[0]), np.zeros(pr.points.shape[0]),
+                 np.zeros(pr.points.shape[0]), np.ones(free.size))
 
 
 def test_schur_inverse_by_solves_when_the_factors_reorder_the_contact_dofs():
@@ -96,8 +115,9 @@ def test_schur_inverse_by_solves_when_the_factors_reorder_the_contact_dofs():
     import scipy.sparse.linalg as spla
     pr, fixed, _ = _problem(refine=0)
     free = np.setdiff1d(np.arange(pr.ndofs), fixed)
-    wb = WoodburySolver(pr.K, free, pr.offset, pr.Gn, pr.Gt)
     A = sp.csc_matrix(pr.K)[free][:, free][:40][:, :40].tocsc()
+    body = SuperLUBody(A, np.arange(34, 40))
+    assert body.from_factors
     lu = spla.splu(A)
 
     class Reordered:                       # the factors of A with other permutations
@@ -105,8 +125,8 @@ def test_schur_inverse_by_solves_when_the_factors_reorder_the_contact_dofs():
         perm_r = perm_c
         solve = staticmethod(lu.solve)
 
-    got = wb._kinv_trailing(Reordered(), 40, 6)
-    assert wb.from_factors[-1] is False
+    got = body._kinv_trailing(Reordered(), 40, 6)
+    assert body.from_factors is False
     np.testing.assert_allclose(got, np.linalg.inv(A.toarray())[34:, 34:], rtol=1e-9)
 
 

@@ -57,7 +57,7 @@ class ContactSettings:
     matrix, or for linear bodies with an FE body "woodbury", one factorisation of the
     bodies' stiffness for the whole load path and the contact terms by the
     Sherman-Morrison-Woodbury formula on the active points
-    (:class:`hpfebe.contact.loading.WoodburySolver`: the same Newton steps up to
+    (:class:`hpfebe.contact.woodbury.WoodburySolver`: the same Newton steps up to
     round-off; measured 7x less CPU on 83,076 dofs with 640 contact points).
     ``secant_start``: the first Newton step from the bonded predictor (an elastic
     solution: plastic points far past yield) with the secant stiffness of the
