@@ -74,6 +74,10 @@ class SuperLUBody:
         E[t + np.arange(m), np.arange(m)] = 1.0
         return lu.solve(E)[t:]
 
+    def kinv_columns(self, j: np.ndarray) -> np.ndarray:
+        """(K^{-1})_cc[:, j] (from the factors)."""
+        return self.kinv_cc[:, j]
+
     def solve(self, b: np.ndarray) -> np.ndarray:
         """K^{-1} b."""
         if self.lu is None:
@@ -92,8 +96,10 @@ class PardisoBody:
     """PARDISO's Cholesky factorisation of one body's stiffness Kb (matrix type 2, its
     upper triangle), with the contact dofs ``c`` marked in ``perm`` for the partial
     solves of MKL's iparm 31: (K^{-1} b)_c of a full b (mode 3, half a solve) and
-    K^{-1} v of a v supported on c (mode 2), and (K^{-1})_cc from unit vectors on c
-    (mode 1, the contact rows only: 0.4 ms per column against 4.4 ms for a solve)."""
+    columns of (K^{-1})_cc from unit vectors on c (mode 1, the contact rows only: 0.4 ms
+    per column against 4.4 ms for a solve), computed when a step first needs them
+    (:meth:`kinv_columns`: the dofs of points that never touch cost nothing).
+    ``solver``: a fresh solver of :func:`~hpfebe.contact.newton_matrix._pardiso_solver`."""
 
     backend = "pardiso"
     from_factors = False
@@ -102,13 +108,12 @@ class PardisoBody:
     BLOCK_ENTRIES = 1_000_000
 
     def __init__(self, Kb: sp.spmatrix, c: np.ndarray, solver):
-        n, m = Kb.shape[0], c.size
+        n = Kb.shape[0]
         self.c, self.n = c, n
-        s = self.pardiso = solver           # a fresh solver of _pardiso_solver()
+        s = self.pardiso = solver
         s.set_matrix_type(2)                # real symmetric positive definite
         s.perm = np.zeros(n, dtype=np.int32)
         s.perm[c] = 1
-        s.set_iparm(31, 1)                  # partial solves on perm (set before analysis)
         self.A = sp.triu(Kb, format="csr")
         self.A.sort_indices()
         self.singular = False
@@ -116,15 +121,19 @@ class PardisoBody:
             self._call(12, 1, np.zeros((n, 1)))   # (analysis with iparm 31 != 0)
         except Exception:  # noqa: BLE001 (PyPardisoError: not positive definite)
             self.singular = True
-            self.kinv_cc = np.zeros((m, m))
-            return
-        self.kinv_cc = np.empty((m, m))
+
+    def kinv_columns(self, j: np.ndarray) -> np.ndarray:
+        """(K^{-1})_cc[:, j] (``j`` positions in c), by partial solves."""
+        self._check()
+        n, c = self.n, self.c
+        out = np.empty((c.size, j.size))
         k = max(1, self.BLOCK_ENTRIES // max(n, 1))
-        for lo in range(0, m, k):
-            cols = np.arange(lo, min(lo + k, m))
+        for lo in range(0, j.size, k):
+            cols = np.arange(lo, min(lo + k, j.size))
             E = np.zeros((n, cols.size), order="F")
-            E[c[cols], np.arange(cols.size)] = 1.0
-            self.kinv_cc[:, cols] = self._call(33, 1, E)[c]
+            E[c[j[cols]], np.arange(cols.size)] = 1.0
+            out[:, cols] = self._call(33, 1, E)[c]
+        return out
 
     def __del__(self):
         s = getattr(self, "pardiso", None)
@@ -214,15 +223,31 @@ class WoodburySolver:
         if 0 < split < self.n and (Kf[:split][:, split:].count_nonzero() or
                                    Kf[split:][:, :split].count_nonzero()):
             raise ValueError("K couples the bodies: no factorisation body by body")
+        # (K^{-1})_cc, its columns filled when first needed (:meth:`_need`; zero between
+        # the bodies)
         self.kinv_cc = np.zeros((self.rows.size, self.rows.size))
+        self.known = np.zeros(self.rows.size, dtype=bool)
+        self.body_of = np.zeros(self.rows.size, dtype=np.int64)
         self.blocks = []                 # per body: (slice, contact positions, factor)
         for lo, hi in ((0, split), (split, self.n)):
             if hi > lo:
                 c = self.rows[(self.rows >= lo) & (self.rows < hi)] - lo
                 f = body_factor(Kf[lo:hi][:, lo:hi], c, backend)
                 pos = self.row_pos[c + lo]
-                self.kinv_cc[np.ix_(pos, pos)] = f.kinv_cc
+                self.body_of[pos] = len(self.blocks)
                 self.blocks.append((slice(lo, hi), pos, f))
+
+    def _need(self, a: np.ndarray) -> None:
+        """The columns ``a`` (positions in ``rows``) of (K^{-1})_cc computed."""
+        new = a[~self.known[a]]
+        if new.size == 0:
+            return
+        for b, (_, pos, f) in enumerate(self.blocks):
+            j = new[self.body_of[new] == b]
+            if j.size:
+                local = np.searchsorted(pos, j)      # pos is increasing (rows sorted)
+                self.kinv_cc[np.ix_(pos, j)] = f.kinv_columns(local)
+        self.known[new] = True
 
     @property
     def from_factors(self) -> list:
@@ -247,6 +272,7 @@ class WoodburySolver:
     def _columns(self, dofs: np.ndarray) -> np.ndarray:
         """(K^{-1})[dofs, dofs] (``dofs`` among the contact dofs)."""
         pos = self.row_pos[dofs]
+        self._need(np.unique(pos))
         return self.kinv_cc[np.ix_(pos, pos)]
 
     def solve(self, wn: np.ndarray, wt: np.ndarray, wtn: np.ndarray,
@@ -259,7 +285,11 @@ class WoodburySolver:
         m = act.size
         # B = [Gn; Gt] on the active points, on the contact dofs (sparse)
         B = self.G_c[np.concatenate([act, act + self.npts])]
-        H = B @ (B @ self.kinv_cc.T).T          # B (K^-1)_cc B^T
+        # B (K^-1)_cc B^T on the contact dofs the active points touch (a)
+        a = np.unique(B.indices)
+        self._need(a)
+        Ba = B[:, a]
+        H = Ba @ (Ba @ self.kinv_cc[np.ix_(a, a)].T).T
         # M H and M B y with M = [[W_n, 0], [-W_tn, W_t]] (diagonal blocks): row scalings
         an, at, atn = wn[act], wt[act], wtn[act]
         MH = np.concatenate([an[:, None] * H[:m], -atn[:, None] * H[:m] + at[:, None] * H[m:]])
