@@ -43,24 +43,27 @@ POT_LAPLACE_SL, POT_LAPLACE_DL = 4, 5   # kp = [log(R) / (2 pi)]
 
 
 @njit(cache=True, inline="always")
-def _neg_hess(i, j, l, m, rx, ry, r2, r4, c1, c2):
-    """-d^2 G_ji / dr_l dr_m (see _lame_grad_kernels)."""
-    ri = rx if i == 0 else ry
-    rj = rx if j == 0 else ry
-    rl = rx if l == 0 else ry
-    rm = rx if m == 0 else ry
-    dij = 1.0 if i == j else 0.0
-    dil = 1.0 if i == l else 0.0
-    dim = 1.0 if i == m else 0.0
-    djl = 1.0 if j == l else 0.0
-    djm = 1.0 if j == m else 0.0
-    dlm = 1.0 if l == m else 0.0
-    h = (-dij * (dlm / r2 - 2.0 * rl * rm / r4)
-         + c2 * (dil * djm + djl * dim) / r2
-         - 2.0 * c2 * (dil * rj + djl * ri) * rm / r4
-         - 2.0 * c2 * (dim * rj * rl + ri * djm * rl + ri * rj * dlm) / r4
-         + 8.0 * c2 * ri * rj * rl * rm / (r4 * r2))
-    return -c1 * h
+def _hess_G(u0, u1, c2):
+    """|r|^2 / c1 d^2 G_ij / dr_l dr_m at r = |r| u, for (i, j) and (l, m) each in
+    (00, 01, 11) (symmetric in both pairs): with G_ij = c1 (-d_ij log|r| + c2 r_i r_j /
+    |r|^2) + const,
+
+        = -d_ij (d_lm - 2 u_l u_m) + c2 (d_il d_jm + d_jl d_im)
+          - 2 c2 (d_il u_j u_m + d_jl u_i u_m + d_im u_j u_l + d_jm u_i u_l + d_lm u_i u_j)
+          + 8 c2 u_i u_j u_l u_m,
+
+    the nine distinct values written out (the delta products resolved)."""
+    u00, u01, u11 = u0 * u0, u0 * u1, u1 * u1
+    h0000 = -(1.0 - 2.0 * u00) + 2.0 * c2 - 10.0 * c2 * u00 + 8.0 * c2 * u00 * u00
+    h0001 = 2.0 * u01 - 4.0 * c2 * u01 + 8.0 * c2 * u00 * u01
+    h0011 = -(1.0 - 2.0 * u11) - 2.0 * c2 * u00 + 8.0 * c2 * u00 * u11
+    h0100 = -6.0 * c2 * u01 + 8.0 * c2 * u01 * u00
+    h0101 = c2 - 2.0 * c2 * (u00 + u11) + 8.0 * c2 * u01 * u01
+    h0111 = -6.0 * c2 * u01 + 8.0 * c2 * u01 * u11
+    h1100 = -(1.0 - 2.0 * u00) - 2.0 * c2 * u11 + 8.0 * c2 * u11 * u00
+    h1101 = 2.0 * u01 - 4.0 * c2 * u01 + 8.0 * c2 * u11 * u01
+    h1111 = -(1.0 - 2.0 * u11) + 2.0 * c2 - 10.0 * c2 * u11 + 8.0 * c2 * u11 * u11
+    return ((h0000, h0001, h0011), (h0100, h0101, h0111), (h1100, h1101, h1111))
 
 
 @njit(cache=True, inline="always")
@@ -69,14 +72,15 @@ def _lame_grad_kernels(rx, ry, ny0, ny1, lam, mu, c1, c2, double, out):
     d/dx_m G_ik (double = False) or d/dx_m K_ik, K_ik = [sigma_y(G(x,.) e_i) n_y]_k.
     With g_l = dG_ji/dr_l
         = c1 (-d_ij r_l + c2 (d_il r_j + d_jl r_i) - 2 c2 r_i r_j r_l/|r|^2)/|r|^2
-    and its r_m-derivative H_jlm; grad_y = -grad_r, so d/dx_m of D_jl = -g_l is -H_jlm."""
+    and its r_m-derivative H_jlm (:func:`_hess_G`); grad_y = -grad_r, so d/dx_m of
+    D_jl = -g_l is -H_jlm."""
     r2 = rx * rx + ry * ry
     r4 = r2 * r2
-    for i in range(2):
-        for m in range(2):
-            rm = rx if m == 0 else ry
-            ri = rx if i == 0 else ry
-            if not double:
+    if not double:
+        for i in range(2):
+            for m in range(2):
+                rm = rx if m == 0 else ry
+                ri = rx if i == 0 else ry
                 for k in range(2):
                     rk = rx if k == 0 else ry
                     dik = 1.0 if i == k else 0.0
@@ -84,12 +88,18 @@ def _lame_grad_kernels(rx, ry, ny0, ny1, lam, mu, c1, c2, double, out):
                     dkm = 1.0 if k == m else 0.0
                     out[(i * 2 + m) * 2 + k] = c1 * (-dik * rm / r2 + c2 * (
                         (dim * rk + ri * dkm) / r2 - 2.0 * ri * rk * rm / r4))
-                continue
-            # d/dx_m of D_jl = -H_jlm (j, l = 0, 1)
-            d00 = _neg_hess(i, 0, 0, m, rx, ry, r2, r4, c1, c2)
-            d01 = _neg_hess(i, 0, 1, m, rx, ry, r2, r4, c1, c2)
-            d10 = _neg_hess(i, 1, 0, m, rx, ry, r2, r4, c1, c2)
-            d11 = _neg_hess(i, 1, 1, m, rx, ry, r2, r4, c1, c2)
+        return
+    inv = 1.0 / math.sqrt(r2)
+    H = _hess_G(rx * inv, ry * inv, c2)
+    rho = -c1 / r2
+    for i in range(2):
+        for m in range(2):
+            # d/dx_m of D_jl is -H_{i j l m}; pair index of (i, j): i + j
+            a0, a1, b0, b1 = i, i + 1, m, m + 1
+            d00 = rho * H[a0][b0]
+            d01 = rho * H[a0][b1]
+            d10 = rho * H[a1][b0]
+            d11 = rho * H[a1][b1]
             div = d00 + d11
             s00 = lam * div + 2.0 * mu * d00
             s11 = lam * div + 2.0 * mu * d11
