@@ -368,3 +368,28 @@ def test_settings_are_a_frozen_validated_object(body):
     with pytest.raises(TypeError, match="settings"):
         solve_friction(body, -D, dict(eps_n=EPS_N, eps_t=EPS_T, friction="coulomb",
                                       mu_f=MU))
+
+
+@pytest.mark.parametrize("law", ["coulomb", "tresca"])
+def test_trial_traction_on_the_bound_after_a_committed_slip_slips(law):
+    """The start of a load step: a point that slipped has its slip committed
+    (updated_slip), so its trial traction lies on the bound to rounding; the law calls
+    it slipping in every case, not as the rounding falls (which decided the Newton path:
+    constitutive.laws module doc)."""
+    from hpfebe.constitutive.laws import penalty_friction, updated_slip
+
+    rng = np.random.default_rng(3)
+    n, eps_n, eps_t = 2000, 1.0 / 2.7e6, 1.0 / 1.3e6
+    pen = rng.uniform(1e-7, 1e-4, n)
+    g_t = rng.uniform(-1e-2, 1e-2, n) * 10.0 ** rng.uniform(-3, 0, n)
+    kw = dict(mu_f=0.3) if law == "coulomb" else dict(F=rng.uniform(1.0, 50.0, n))
+    # a slipping state: an old slip far from g_t
+    first = penalty_friction(pen, g_t, g_t - np.sign(g_t) * 1e-3, eps_n, eps_t, **kw)
+    assert np.all(first.state == SLIP)
+    slip = updated_slip(g_t, first, eps_t)
+    again = penalty_friction(pen, g_t, slip, eps_n, eps_t, **kw)
+    assert np.all(again.state == SLIP)
+    np.testing.assert_allclose(again.t_t, first.t_t, rtol=1e-9)
+    # inside the bound by more than the rounding: stick, as before
+    inside = penalty_friction(pen, g_t, g_t - 0.99 * eps_t * first.t_t, eps_n, eps_t, **kw)
+    assert np.all(inside.state == STICK)

@@ -190,7 +190,10 @@ def test_displacement_between_dirichlet_values(quick_run):
 # ----------------------------------------------------------------------------- LU reuse
 def test_newton_reuses_factorisations_without_changing_the_result(monkeypatch):
     """LoadSteps keeps the sparse LUs of Newton matrices met before (the semismooth
-    iterates revisit contact patterns): fewer factorisations, bit-identical iterates."""
+    iterates revisit contact patterns; here every load step after the first solves in
+    one step with the Newton matrix of the converged state before it): fewer
+    factorisations than Newton steps, bit-identical iterates with the cache cut to the
+    last LU."""
     import scipy.sparse.linalg as spla
 
     from hpfebe.contact import loading
@@ -204,10 +207,10 @@ def test_newton_reuses_factorisations_without_changing_the_result(monkeypatch):
     monkeypatch.setattr(loading.spla, "splu", counting_splu)
     _, cached = _solve(_meshes())
     n_cached = len(calls)
+    assert n_cached < sum(cached.iterations)
     calls.clear()
     monkeypatch.setattr(loading.LoadSteps, "LU_CACHE", 0)     # keeps only the last LU
     _, fresh = _solve(_meshes())
-    assert len(calls) == sum(fresh.iterations)    # no matrix repeats its predecessor
-    assert n_cached < len(calls)
+    assert n_cached <= len(calls) <= sum(fresh.iterations)
     assert list(cached.iterations) == list(fresh.iterations)
     np.testing.assert_array_equal(cached.U, fresh.U)

@@ -21,6 +21,15 @@ Return map (backward Euler, Section 4.2.5), with s the slip bound:
               traction),
     slip   <- g_t - eps_t t_t      after a converged step (:func:`updated_slip`).
 
+A trial traction within the rounding of its own evaluation of the bound,
+||t_trial| - s| <= 8 macheps ((|g_t| + |slip|) / eps_t + s), slips (the traction is
+the same either way; only the derivative differs): at the start of a load step every
+point that slipped in the last one lies there, its slip just committed, and rounding
+decided its stick/slip state in the first Newton iterate and with it the Newton path
+(measured on the adaptive FE/FE scene of Figures 4.13-4.16: 931 Newton iterations over
+its 48 meshes, counts differing by up to 4 per mesh between two linear solvers; with
+the rule 383, the same for both, every load step after the first one in one iteration).
+
 The return map is :func:`tresca_return` (compiled, one point) and
 :func:`friction_projection` (arrays): the penalty path applies it to t_trial, the mortar
 path (Algorithms 4.4, 4.5: :mod:`hpfebe.solvers.uzawa`, :mod:`hpfebe.solvers.semismooth`)
@@ -44,6 +53,7 @@ import numpy as np
 from numba import njit
 
 OPEN, STICK, SLIP = 0, 1, 2
+_EPS = float(np.finfo(float).eps)
 STATE_NAMES = {OPEN: "open", STICK: "stick", SLIP: "slip"}
 
 
@@ -100,7 +110,9 @@ def penalty_friction(penetration, g_t, slip, eps_n: float, eps_t: float, mu_f=No
         s = mu_f * p_n
         carries = in_contact
     trial = np.where(carries, trial, 0.0)
-    stick = carries & (np.abs(trial) <= s)
+    # on the bound to the rounding of (g_t - slip) / eps_t: slip (module doc)
+    rnd = 8.0 * _EPS * ((np.abs(g_t) + np.abs(slip)) / eps_t + s)
+    stick = carries & (np.abs(trial) <= s - rnd)
     slipping = carries & ~stick
     sg = np.sign(trial)
     t_t = np.where(carries, friction_projection(trial, s), 0.0)     # the return map
