@@ -52,13 +52,35 @@ def test_part_table_be_adds_the_trace_energy_columns():
 
 
 def test_work_precision_rows_take_the_minimum_of_the_repeats():
-    prm = interface.ConvergenceScene(timing_repeats=2)
+    # the sweep's own timing (1e3 s each) is slower than any real one of this tiny run,
+    # and within the (large) budget: the minimum is a repeat's, the maximum the sweep's
+    prm = interface.ConvergenceScene(timing_repeats=2, timing_budget_s=1e4)
     rows = [dict(problem="smooth", series="h", p=1, fe_h_inv=2, be_h_inv=3,
                  assembly_s=1e3, solve_s=1e3, wall_time_s=2e3, fe_h1=0.1)]
     out = interface.work_precision_rows(prm, rows)
     assert out[0]["fe_h1"] == 0.1
     assert out[0]["assembly_s"] < 1e3 and out[0]["solve_s"] < 1e3
     assert out[0]["wall_time_s"] < out[0]["wall_time_max_s"] == 2e3
+    assert out[0]["timings"] == 2
+
+
+def test_work_precision_rows_stop_repeating_a_run_at_the_timing_budget():
+    # 2 s of timings is past the 1 s budget: that run keeps its one timing, the other
+    # (0.1 s) is timed timing_repeats times
+    prm = interface.ConvergenceScene(timing_repeats=3, timing_budget_s=1.0)
+    rows = [dict(problem="smooth", series="h", p=1, fe_h_inv=2, be_h_inv=3,
+                 assembly_s=a, solve_s=a, wall_time_s=2 * a) for a in (1.0, 0.05)]
+    slow, fast = interface.work_precision_rows(prm, rows)
+    assert slow["timings"] == 1
+    assert slow["wall_time_s"] == slow["wall_time_max_s"] == 2.0
+    assert fast["timings"] == 3 and fast["wall_time_s"] <= 0.1
+
+
+@pytest.mark.parametrize("bad", [dict(timing_repeats=0), dict(timing_repeats="3"),
+                                 dict(timing_budget_s=0.0), dict(timing_budget_s=np.nan)])
+def test_convergence_scene_rejects_bad_timing_parameters(bad):
+    with pytest.raises((TypeError, ValueError), match="timing_"):
+        interface.ConvergenceScene(**bad)
 
 
 def test_solution_fields_meet_the_exact_solution():
