@@ -416,7 +416,7 @@ def work_precision_rows(prm: ConvergenceScene, rows: list[dict]) -> list[dict]:
     ``timing_repeats`` timings or its timings sum to ``timing_budget_s`` (as timeit's
     autorange: a run of seconds is timed once or twice, its relative spread is small;
     measured, full configuration: the largest run 2.4 s, its three timings within 13 %;
-    the repeats 12.5 s of CPU before, 6 s now)."""
+    the repeats about 11.9 s before (3 timings of every run), 6.2 s now)."""
     asm = np.array([[r["assembly_s"] for r in rows]])
     sol = np.array([[r["solve_s"] for r in rows]])
     for _ in range(prm.timing_repeats - 1):
