@@ -9,8 +9,9 @@ Example 2 (singular, (2.13)-(2.15)): h-version p = 1, FE h^-1 = 4..256, BE h^-1 
 p-version p = 1..7 on FE h^-1 = 4, BE h^-1 = 6 (Tables 2.3, 2.4; Figure 2.4).
 Figures 2.1 and 2.3: the computed solutions.  Beyond the thesis: error against wall time
 (figure_work_precision_ch2), each run timed up to ``timing_repeats`` times, fewer once
-its timings sum to ``timing_budget_s`` (the minimum is plotted).  Two :data:`SCENES`: Example 1, and Example 2 with the work-precision figure,
-which times the runs of both examples' sweeps: a run computes each sweep once
+its timings sum to ``timing_budget_s`` (the minimum is plotted).  Two :data:`SCENES`:
+Example 1, and Example 2 with the work-precision figure, which times the runs of both
+examples' sweeps: a run computes each sweep once
 (:func:`sweep_memo`), so the work-precision figure repeats the cheap Example 1 sweep
 only when the scenes run as separate jobs.  Rates: log(e_prev/e) /
 log(h_prev/h), for the p-series log(e_prev/e) / log(p/p_prev).  The model problems, mesh
